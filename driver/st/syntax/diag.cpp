@@ -1,0 +1,67 @@
+// Collection and rendering of compiler diagnostics.
+#include "diag.hpp"
+
+namespace plcfi::st {
+
+namespace {
+Diagnostic& push(std::vector<Diagnostic>& v, Diagnostic& overflow, Severity sev, std::string code,
+                 SourceLoc loc, std::string msg) {
+  if (v.size() >= DiagEngine::kMaxStored) {
+    overflow = Diagnostic{};
+    return overflow;
+  }
+  v.push_back(Diagnostic{sev, std::move(code), std::move(msg), loc, {}});
+  return v.back();
+}
+}  // namespace
+
+Diagnostic& DiagEngine::error(std::string code, SourceLoc loc, std::string message) {
+  ++errors_;
+  return push(diags_, overflow_, Severity::Error, std::move(code), loc, std::move(message));
+}
+
+Diagnostic& DiagEngine::warning(std::string code, SourceLoc loc, std::string message) {
+  ++warnings_;
+  return push(diags_, overflow_, Severity::Warning, std::move(code), loc, std::move(message));
+}
+
+static void render_loc(std::string& out, const SourceManager& sm, SourceLoc loc) {
+  if (loc.file < sm.size()) out += sm.file(loc.file).path;
+  else out += "<input>";
+  if (loc.valid()) {
+    out += ':' + std::to_string(loc.line) + ':' + std::to_string(loc.col);
+  }
+}
+
+static void render_snippet(std::string& out, const SourceManager& sm, SourceLoc loc) {
+  if (!loc.valid() || loc.file >= sm.size()) return;
+  std::string_view line = sm.file(loc.file).line_text(loc.line);
+  out += "  ";
+  out.append(line.data(), line.size());
+  out += "\n  ";
+  for (uint32_t i = 1; i < loc.col && i <= line.size(); ++i) out += line[i - 1] == '\t' ? '\t' : ' ';
+  out += "^\n";
+}
+
+std::string DiagEngine::render(const Diagnostic& d) const {
+  std::string out;
+  render_loc(out, *sm_, d.loc);
+  out += d.severity == Severity::Error ? ": error[" : d.severity == Severity::Warning ? ": warning[" : ": note[";
+  out += d.code + "]: " + d.message + "\n";
+  render_snippet(out, *sm_, d.loc);
+  for (const auto& [loc, text] : d.notes) {
+    render_loc(out, *sm_, loc);
+    out += ": note: " + text + "\n";
+  }
+  return out;
+}
+
+std::string DiagEngine::render_all() const {
+  std::string out;
+  for (const auto& d : diags_) out += render(d);
+  if (errors_ + warnings_ > diags_.size())
+    out += "(" + std::to_string(errors_ + warnings_ - diags_.size()) + " further diagnostics not shown)\n";
+  return out;
+}
+
+}  // namespace plcfi::st

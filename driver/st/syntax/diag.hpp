@@ -1,0 +1,49 @@
+// Diagnostics: the compiler collects them, never throws; they render as
+// `file:line:col: error[ST123]: message`, the source line and a caret.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "source.hpp"
+
+namespace plcfi::st {
+
+enum class Severity { Note, Warning, Error };
+
+struct Diagnostic {
+  Severity severity = Severity::Error;
+  std::string code;     // "ST101"; the catalogue is docs/diagnostics.md
+  std::string message;
+  SourceLoc loc;
+  // Secondary locations ("declared here").
+  std::vector<std::pair<SourceLoc, std::string>> notes;
+};
+
+class DiagEngine {
+ public:
+  explicit DiagEngine(const SourceManager& sm) : sm_(&sm) {}
+
+  Diagnostic& error(std::string code, SourceLoc loc, std::string message);
+  Diagnostic& warning(std::string code, SourceLoc loc, std::string message);
+
+  const std::vector<Diagnostic>& all() const { return diags_; }
+  size_t error_count() const { return errors_; }
+  size_t warning_count() const { return warnings_; }
+  bool has_errors() const { return errors_ != 0; }
+  // Caps runaway output on garbage input; further errors are counted but not stored.
+  static constexpr size_t kMaxStored = 500;
+
+  // Renders one diagnostic with its source line and caret.
+  std::string render(const Diagnostic& d) const;
+  std::string render_all() const;
+
+ private:
+  const SourceManager* sm_;
+  std::vector<Diagnostic> diags_;
+  Diagnostic overflow_;
+  size_t errors_ = 0;
+  size_t warnings_ = 0;
+};
+
+}  // namespace plcfi::st

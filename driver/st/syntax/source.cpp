@@ -1,0 +1,59 @@
+// Source buffers, line tables and the case-insensitive name helpers.
+#include "source.hpp"
+
+#include <cctype>
+#include <fstream>
+#include <sstream>
+
+namespace plcfi::st {
+
+std::string_view SourceFile::line_text(uint32_t line) const {
+  if (line == 0 || line > line_starts.size()) return {};
+  size_t begin = line_starts[line - 1];
+  size_t end = line < line_starts.size() ? line_starts[line] : text.size();
+  while (end > begin && (text[end - 1] == '\n' || text[end - 1] == '\r')) --end;
+  return std::string_view(text).substr(begin, end - begin);
+}
+
+uint32_t SourceManager::add(std::string path, std::string text) {
+  auto f = std::make_unique<SourceFile>();
+  f->path = std::move(path);
+  f->text = std::move(text);
+  f->line_starts.push_back(0);
+  for (size_t i = 0; i < f->text.size(); ++i)
+    if (f->text[i] == '\n') f->line_starts.push_back(static_cast<uint32_t>(i + 1));
+  files_.push_back(std::move(f));
+  return static_cast<uint32_t>(files_.size() - 1);
+}
+
+bool SourceManager::load(const std::string& path, uint32_t* index, std::string* err) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    *err = path + ": cannot open file";
+    return false;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) {
+    *err = path + ": read error";
+    return false;
+  }
+  *index = add(path, ss.str());
+  return true;
+}
+
+std::string canon(std::string_view name) {
+  std::string out(name);
+  for (char& c : out) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return out;
+}
+
+bool iequals(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (std::toupper(static_cast<unsigned char>(a[i])) != std::toupper(static_cast<unsigned char>(b[i])))
+      return false;
+  return true;
+}
+
+}  // namespace plcfi::st
