@@ -1,0 +1,674 @@
+// ST lexer: turns a source buffer into tokens and decodes every literal form.
+#include "lexer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <string>
+
+namespace plcfi::st {
+
+namespace {
+
+constexpr std::array<std::string_view, static_cast<size_t>(Tok::Count)> kTokNames = {
+    "end of file", "identifier", "integer literal", "real literal", "string literal",
+    "wide string literal", "time literal", "direct address",
+    "'('", "')'", "'['", "']'", "','", "';'", "':'", "':='", "'=>'", "'REF='",
+    "'.'", "'..'", "'#'", "'^'", "'+'", "'-'", "'*'", "'**'", "'/'", "'&'",
+    "'='", "'<>'", "'<'", "'>'", "'<='", "'>='",
+#define PLCFI_ST_KW_NAME(name, text) text,
+    PLCFI_ST_KEYWORDS(PLCFI_ST_KW_NAME)
+#undef PLCFI_ST_KW_NAME
+};
+
+struct KeywordEntry {
+  std::string_view text;
+  Tok kind;
+};
+
+constexpr KeywordEntry kKeywords[] = {
+#define PLCFI_ST_KW_ENTRY(name, text) {text, Tok::name},
+    PLCFI_ST_KEYWORDS(PLCFI_ST_KW_ENTRY)
+#undef PLCFI_ST_KW_ENTRY
+};
+
+bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+char upper(char c) { return static_cast<char>(std::toupper(static_cast<unsigned char>(c))); }
+
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  c = upper(c);
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+// Days since 1970-01-01 of a proleptic Gregorian date (H. Hinnant's days_from_civil).
+int64_t days_from_civil(int64_t y, unsigned m, unsigned d) {
+  y -= m <= 2;
+  const int64_t era = (y >= 0 ? y : y - 399) / 400;
+  const unsigned yoe = static_cast<unsigned>(y - era * 400);
+  const unsigned doy = (153 * (m + (m > 2 ? -3 : 9)) + 2) / 5 + d - 1;
+  const unsigned doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  return era * 146097 + static_cast<int64_t>(doe) - 719468;
+}
+
+unsigned days_in_month(int64_t y, unsigned m) {
+  static constexpr unsigned kDays[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  if (m == 2 && ((y % 4 == 0 && y % 100 != 0) || y % 400 == 0)) return 29;
+  return kDays[m - 1];
+}
+
+enum class TimePrefix { None, Duration, Date, TimeOfDay, DateTime };
+
+TimePrefix classify_prefix(std::string_view word, bool* is_long) {
+  const std::string w = canon(word);
+  *is_long = false;
+  if (w == "T" || w == "TIME") return TimePrefix::Duration;
+  if (w == "LT" || w == "LTIME") return *is_long = true, TimePrefix::Duration;
+  if (w == "D" || w == "DATE") return TimePrefix::Date;
+  if (w == "LD" || w == "LDATE") return *is_long = true, TimePrefix::Date;
+  if (w == "TOD" || w == "TIME_OF_DAY") return TimePrefix::TimeOfDay;
+  if (w == "LTOD" || w == "LTIME_OF_DAY") return *is_long = true, TimePrefix::TimeOfDay;
+  if (w == "DT" || w == "DATE_AND_TIME") return TimePrefix::DateTime;
+  if (w == "LDT" || w == "LDATE_AND_TIME") return *is_long = true, TimePrefix::DateTime;
+  return TimePrefix::None;
+}
+
+constexpr int64_t kNsPerSec = 1'000'000'000;
+constexpr int64_t kNsPerDay = 86'400 * kNsPerSec;
+
+}  // namespace
+
+std::string_view tok_name(Tok kind) {
+  const auto i = static_cast<size_t>(kind);
+  return i < kTokNames.size() ? kTokNames[i] : "token";
+}
+
+Tok keyword_kind(std::string_view word) {
+  if (word.empty() || word.size() > 20) return Tok::Ident;
+  for (const auto& kw : kKeywords)
+    if (iequals(kw.text, word)) return kw.kind;
+  return Tok::Ident;
+}
+
+Lexer::Lexer(const SourceManager& sm, uint32_t file, DiagEngine& diags)
+    : src_(sm.file(file)), file_(file), diags_(diags), text_(src_.text) {}
+
+SourceLoc Lexer::loc_at(size_t offset) const {
+  const auto& starts = src_.line_starts;
+  auto it = std::upper_bound(starts.begin(), starts.end(), static_cast<uint32_t>(offset));
+  const size_t line = static_cast<size_t>(it - starts.begin());  // >= 1: starts[0] == 0
+  return SourceLoc{file_, static_cast<uint32_t>(line), static_cast<uint32_t>(offset - starts[line - 1] + 1)};
+}
+
+void Lexer::error(std::string_view code, size_t offset, std::string message) {
+  diags_.error(std::string(code), loc_at(offset), std::move(message));
+}
+
+Token Lexer::make(Tok kind, size_t begin) const {
+  Token t;
+  t.kind = kind;
+  t.offset = static_cast<uint32_t>(begin);
+  t.loc = loc_at(begin);
+  t.end = loc_at(pos_);
+  // A token never spans lines except an unterminated construct; keep `end` on the start line
+  // so "after the previous token" locations stay on the statement's line.
+  if (t.end.line != t.loc.line) t.end = SourceLoc{file_, t.loc.line, t.loc.col + 1};
+  t.text = text_.substr(begin, pos_ - begin);
+  return t;
+}
+
+void Lexer::skip_trivia() {
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v') {
+      ++pos_;
+    } else if (c == '/' && peek(1) == '/') {
+      while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+    } else if ((c == '(' && peek(1) == '*') || (c == '/' && peek(1) == '*')) {
+      // Both comment styles nest, each counting only its own delimiters, so that commenting
+      // out code that already contains comments works.
+      const char open = c;
+      const char close = c == '(' ? ')' : '/';
+      const size_t begin = pos_;
+      int depth = 0;
+      while (pos_ < text_.size()) {
+        if (text_[pos_] == open && peek(1) == '*') {
+          ++depth;
+          pos_ += 2;
+        } else if (text_[pos_] == '*' && peek(1) == close) {
+          pos_ += 2;
+          if (--depth == 0) break;
+        } else {
+          ++pos_;
+        }
+      }
+      if (depth != 0) {
+        error("ST002", begin, open == '(' ? "unterminated comment: '(*' has no matching '*)'"
+                                          : "unterminated comment: '/*' has no matching '*/'");
+        pos_ = text_.size();
+      }
+    } else if (c == '{') {
+      const size_t begin = pos_;
+      const size_t close = text_.find('}', pos_);
+      if (close == std::string_view::npos) {
+        error("ST011", begin, "unterminated pragma: '{' has no matching '}'");
+        pos_ = text_.size();
+      } else {
+        pos_ = close + 1;
+      }
+    } else {
+      break;
+    }
+  }
+}
+
+Token Lexer::next() {
+  Token tok = [this]() -> Token {
+    skip_trivia();
+    const size_t begin = pos_;
+    if (pos_ >= text_.size()) return make(Tok::Eof, begin);
+    const char c = text_[pos_];
+    if (is_ident_start(c)) return lex_identifier();
+    if (is_digit(c)) return lex_number();
+    if (c == '\'' || c == '"') return lex_string(c);
+    if (c == '%') return lex_direct_address();
+    auto two = [&](char second) { return peek(1) == second; };
+    Tok kind = Tok::Eof;
+    size_t len = 1;
+    switch (c) {
+      case '(': kind = Tok::LParen; break;
+      case ')': kind = Tok::RParen; break;
+      case '[': kind = Tok::LBracket; break;
+      case ']': kind = Tok::RBracket; break;
+      case ',': kind = Tok::Comma; break;
+      case ';': kind = Tok::Semi; break;
+      case ':': if (two('=')) kind = Tok::Assign, len = 2; else kind = Tok::Colon; break;
+      case '=': if (two('>')) kind = Tok::Arrow, len = 2; else kind = Tok::Eq; break;
+      case '.': if (two('.')) kind = Tok::DotDot, len = 2; else kind = Tok::Dot; break;
+      case '#': kind = Tok::Hash; break;
+      case '^': kind = Tok::Caret; break;
+      case '+': kind = Tok::Plus; break;
+      case '-': kind = Tok::Minus; break;
+      case '*': if (two('*')) kind = Tok::Power, len = 2; else kind = Tok::Star; break;
+      case '/': kind = Tok::Slash; break;
+      case '&': kind = Tok::Amp; break;
+      case '<':
+        if (two('>')) kind = Tok::Ne, len = 2;
+        else if (two('=')) kind = Tok::Le, len = 2;
+        else kind = Tok::Lt;
+        break;
+      case '>': if (two('=')) kind = Tok::Ge, len = 2; else kind = Tok::Gt; break;
+      default: break;
+    }
+    if (kind != Tok::Eof) {
+      pos_ += len;
+      return make(kind, begin);
+    }
+    // Garbage: report a run of unknown bytes once (a UTF-8 character is several bytes).
+    size_t end = pos_ + 1;
+    while (end < text_.size() && (static_cast<unsigned char>(text_[end]) & 0xC0) == 0x80) ++end;
+    const std::string shown(text_.substr(pos_, end - pos_));
+    error("ST001", begin, "unexpected character '" + shown + "'");
+    pos_ = end;
+    return next();
+  }();
+  prev_ = tok.kind;
+  return tok;
+}
+
+Token Lexer::lex_identifier() {
+  const size_t begin = pos_;
+  while (pos_ < text_.size() && is_ident_char(text_[pos_])) ++pos_;
+  const std::string_view word = text_.substr(begin, pos_ - begin);
+  if (peek() == '#') {
+    bool is_long = false;
+    if (classify_prefix(word, &is_long) != TimePrefix::None) return lex_time_literal(begin, word);
+  }
+  // REF= is one token; REF alone is an ordinary name (the REF() operator).
+  if (peek() == '=' && peek(1) != '>' && iequals(word, "REF")) {
+    ++pos_;
+    return make(Tok::RefAssign, begin);
+  }
+  return make(keyword_kind(word), begin);
+}
+
+Token Lexer::lex_number() {
+  const size_t begin = pos_;
+  auto digits = [&](size_t from) {
+    size_t p = from;
+    while (p < text_.size() && (is_digit(text_[p]) || text_[p] == '_')) ++p;
+    return p;
+  };
+  pos_ = digits(pos_);
+  // After '.', digits are a bit number (w.3) or an address part, never a fraction.
+  const bool bit_context = prev_ == Tok::Dot;
+  bool is_real = false;
+  if (!bit_context && peek() == '.' && is_digit(peek(1))) {
+    is_real = true;
+    pos_ = digits(pos_ + 1);
+  }
+  if (!bit_context && (peek() == 'e' || peek() == 'E') &&
+      (is_digit(peek(1)) || ((peek(1) == '+' || peek(1) == '-') && is_digit(peek(2))))) {
+    is_real = true;
+    pos_ = digits(pos_ + 2);
+  }
+  Token tok;
+  if (!is_real && peek() == '#') {
+    // Based integer: 2#1010, 8#17, 16#FF.
+    std::string base_text;
+    for (size_t i = begin; i < pos_; ++i)
+      if (text_[i] != '_') base_text += text_[i];
+    ++pos_;
+    const size_t body = pos_;
+    while (pos_ < text_.size() && is_ident_char(text_[pos_])) ++pos_;
+    tok = make(Tok::IntLit, begin);
+    const std::string_view lit = tok.text;
+    const int base = base_text == "2" ? 2 : base_text == "8" ? 8 : base_text == "16" ? 16 : 0;
+    if (base == 0) {
+      error("ST006", begin, "unsupported base '" + base_text + "' in literal '" + std::string(lit) +
+                                "' (expected 2, 8 or 16)");
+      tok.bad = true;
+      return tok;
+    }
+    if (body == pos_) {
+      error("ST005", begin, "missing digits after '" + base_text + "#' in literal '" + std::string(lit) + "'");
+      tok.bad = true;
+      return tok;
+    }
+    uint64_t value = 0;
+    bool overflow = false;
+    for (size_t i = body; i < pos_; ++i) {
+      const char d = text_[i];
+      if (d == '_') continue;
+      const int v = hex_value(d);
+      if (v < 0 || v >= base) {
+        error("ST006", i, "invalid digit '" + std::string(1, d) + "' in base-" + std::to_string(base) +
+                              " literal '" + std::string(lit) + "'");
+        tok.bad = true;
+        return tok;
+      }
+      if (__builtin_mul_overflow(value, static_cast<uint64_t>(base), &value) ||
+          __builtin_add_overflow(value, static_cast<uint64_t>(v), &value))
+        overflow = true;
+    }
+    if (overflow) {
+      error("ST007", begin, "integer literal '" + std::string(lit) + "' does not fit in 64 bits");
+      tok.bad = true;
+    }
+    tok.int_value = overflow ? 0 : value;
+    return tok;
+  }
+  // A letter glued to a number (12abc, 1.5x) is a malformed literal, not two tokens.
+  if (pos_ < text_.size() && is_ident_char(text_[pos_])) {
+    while (pos_ < text_.size() && (is_ident_char(text_[pos_]) || text_[pos_] == '.')) ++pos_;
+    tok = make(is_real ? Tok::RealLit : Tok::IntLit, begin);
+    error("ST005", begin, "invalid numeric literal '" + std::string(tok.text) + "'");
+    tok.bad = true;
+    return tok;
+  }
+  tok = make(is_real ? Tok::RealLit : Tok::IntLit, begin);
+  std::string clean;
+  for (char d : tok.text)
+    if (d != '_') clean += d;
+  if (is_real) {
+    tok.lit = LiteralKind::Real;
+    double v = 0;
+    auto [ptr, ec] = std::from_chars(clean.data(), clean.data() + clean.size(), v);
+    if (ec == std::errc::result_out_of_range || !std::isfinite(v)) {
+      error("ST012", begin, "real literal '" + std::string(tok.text) + "' is out of range");
+      tok.bad = true;
+    } else if (ec != std::errc() || ptr != clean.data() + clean.size()) {
+      error("ST005", begin, "invalid numeric literal '" + std::string(tok.text) + "'");
+      tok.bad = true;
+    }
+    tok.real_value = v;
+    return tok;
+  }
+  uint64_t value = 0;
+  for (char d : clean) {
+    if (__builtin_mul_overflow(value, uint64_t{10}, &value) ||
+        __builtin_add_overflow(value, static_cast<uint64_t>(d - '0'), &value)) {
+      error("ST007", begin, "integer literal '" + std::string(tok.text) + "' does not fit in 64 bits");
+      tok.bad = true;
+      value = 0;
+      break;
+    }
+  }
+  tok.int_value = value;
+  return tok;
+}
+
+Token Lexer::lex_string(char quote) {
+  const size_t begin = pos_;
+  ++pos_;
+  std::string value;
+  bool terminated = false;
+  bool bad = false;
+  while (pos_ < text_.size()) {
+    const char c = text_[pos_];
+    if (c == quote) {
+      ++pos_;
+      terminated = true;
+      break;
+    }
+    // Strings cannot span lines: stopping at the line end keeps one missing quote from
+    // swallowing the rest of the file.
+    if (c == '\n' || c == '\r') break;
+    if (c != '$') {
+      value += c;
+      ++pos_;
+      continue;
+    }
+    const char e = peek(1);
+    const char u = upper(e);
+    if (e == '$' || e == '\'' || e == '"') {
+      value += e;
+      pos_ += 2;
+    } else if (u == 'L' || u == 'N') {
+      value += '\n';
+      pos_ += 2;
+    } else if (u == 'P') {
+      value += '\f';
+      pos_ += 2;
+    } else if (u == 'R') {
+      value += '\r';
+      pos_ += 2;
+    } else if (u == 'T') {
+      value += '\t';
+      pos_ += 2;
+    } else if (hex_value(e) >= 0 && hex_value(peek(2)) >= 0) {
+      if (quote == '"' && hex_value(peek(3)) >= 0 && hex_value(peek(4)) >= 0) {
+        // WSTRING: $hhhh is one UTF-16 code unit; store it as UTF-8.
+        const unsigned cp = static_cast<unsigned>(hex_value(e) << 12 | hex_value(peek(2)) << 8 |
+                                                  hex_value(peek(3)) << 4 | hex_value(peek(4)));
+        if (cp < 0x80) {
+          value += static_cast<char>(cp);
+        } else if (cp < 0x800) {
+          value += static_cast<char>(0xC0 | (cp >> 6));
+          value += static_cast<char>(0x80 | (cp & 0x3F));
+        } else {
+          value += static_cast<char>(0xE0 | (cp >> 12));
+          value += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
+          value += static_cast<char>(0x80 | (cp & 0x3F));
+        }
+        pos_ += 5;
+      } else {
+        value += static_cast<char>(hex_value(e) * 16 + hex_value(peek(2)));
+        pos_ += 3;
+      }
+    } else {
+      const std::string shown = (e == '\0' || e == '\n' || e == '\r') ? std::string("$") : std::string("$") + e;
+      error("ST004", pos_, "invalid escape sequence '" + shown +
+                               "' in string (use $$, $', $\", $L, $N, $P, $R, $T or $hh)");
+      bad = true;
+      pos_ += (e == '\0' || e == '\n' || e == '\r') ? 1 : 2;
+    }
+  }
+  Token tok = make(quote == '\'' ? Tok::StringLit : Tok::WStringLit, begin);
+  tok.lit = quote == '\'' ? LiteralKind::String : LiteralKind::WString;
+  tok.str_value = std::move(value);
+  if (!terminated) {
+    error("ST003", begin, std::string("unterminated string literal: missing closing quote (") + quote +
+                              ") before the end of the line");
+    bad = true;
+  }
+  tok.bad = bad;
+  return tok;
+}
+
+Token Lexer::lex_direct_address() {
+  const size_t begin = pos_;
+  ++pos_;
+  while (pos_ < text_.size() && (is_ident_char(text_[pos_]) || text_[pos_] == '*' ||
+                                 (text_[pos_] == '.' && is_digit(peek(1)))))
+    ++pos_;
+  Token tok = make(Tok::DirectAddr, begin);
+  const std::string written(tok.text);
+  auto fail = [&](size_t at, const std::string& why) {
+    error("ST010", at, "invalid direct address '" + written + "': " + why);
+    tok.bad = true;
+    return tok;
+  };
+  size_t p = begin + 1;
+  const char area = upper(p < pos_ ? text_[p] : '\0');
+  if (area != 'I' && area != 'Q' && area != 'M')
+    return fail(begin, "the location prefix must be I, Q or M");
+  tok.area = area;
+  ++p;
+  if (p < pos_ && std::isalpha(static_cast<unsigned char>(text_[p]))) {
+    const char size = upper(text_[p]);
+    if (size != 'X' && size != 'B' && size != 'W' && size != 'D' && size != 'L')
+      return fail(p, std::string("unknown size '") + text_[p] + "' (expected X, B, W, D or L)");
+    tok.size = size;
+    ++p;
+  }
+  if (p < pos_ && text_[p] == '*') {
+    // Partly specified address (x AT %I* : BOOL), completed by VAR_CONFIG.
+    if (p + 1 != pos_) return fail(p, "'*' must end the address");
+    return tok;
+  }
+  if (p >= pos_) return fail(pos_, "missing address number after '" + written + "'");
+  while (p < pos_) {
+    if (!is_digit(text_[p])) return fail(p, std::string("unexpected '") + text_[p] + "' in address");
+    uint64_t v = 0;
+    while (p < pos_ && is_digit(text_[p])) {
+      v = v * 10 + static_cast<uint64_t>(text_[p] - '0');
+      if (v > UINT32_MAX) return fail(begin, "address part too large");
+      ++p;
+    }
+    tok.parts.push_back(static_cast<uint32_t>(v));
+    if (p < pos_) {
+      if (text_[p] != '.') return fail(p, std::string("unexpected '") + text_[p] + "' in address");
+      ++p;
+    }
+  }
+  return tok;
+}
+
+// pos_ is at the '#' after a time prefix (T, TIME, D, TOD, DT, their long forms, ...).
+Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
+  bool is_long = false;
+  const TimePrefix kind = classify_prefix(prefix, &is_long);
+  ++pos_;  // '#'
+  bool ok = true;
+  std::string why;
+  size_t why_at = pos_;
+  auto fail = [&](size_t at, std::string message) {
+    if (ok) {
+      ok = false;
+      why_at = at;
+      why = std::move(message);
+    }
+    return false;
+  };
+  // Reads up to max_digits decimal digits ('_' allowed between them); false when none.
+  auto read_uint = [&](uint64_t* v, size_t* ndigits) {
+    *v = 0;
+    *ndigits = 0;
+    while (pos_ < text_.size() && (is_digit(text_[pos_]) || (text_[pos_] == '_' && *ndigits > 0 && is_digit(peek(1))))) {
+      if (text_[pos_] != '_') {
+        if (*v > UINT64_MAX / 10 - 9) return fail(pos_, "number too large");
+        *v = *v * 10 + static_cast<uint64_t>(text_[pos_] - '0');
+        ++*ndigits;
+      }
+      ++pos_;
+    }
+    return *ndigits > 0;
+  };
+  // Nanoseconds of a decimal fraction (digits after the '.') of `unit` nanoseconds.
+  auto read_fraction = [&](int64_t unit) {
+    int64_t ns = 0;
+    int64_t place = unit;
+    while (pos_ < text_.size() && (is_digit(text_[pos_]) || text_[pos_] == '_')) {
+      if (text_[pos_] != '_') {
+        place /= 10;
+        ns += place * (text_[pos_] - '0');
+      }
+      ++pos_;
+    }
+    return ns;
+  };
+  auto add_checked = [&](int64_t* acc, uint64_t count, int64_t unit) {
+    int64_t part = 0;
+    if (count > static_cast<uint64_t>(INT64_MAX) ||
+        __builtin_mul_overflow(static_cast<int64_t>(count), unit, &part) ||
+        __builtin_add_overflow(*acc, part, acc))
+      return fail(begin, "value out of range (at most about 292 years)");
+    return true;
+  };
+  auto expect_char = [&](char c, const char* what) {
+    if (peek() == c) {
+      ++pos_;
+      return true;
+    }
+    return fail(pos_, std::string("expected '") + c + "' " + what);
+  };
+  // YYYY-MM-DD -> days since 1970-01-01.
+  auto read_date = [&](int64_t* days) {
+    uint64_t y = 0, m = 0, d = 0;
+    size_t n = 0;
+    const size_t at = pos_;
+    if (!read_uint(&y, &n) || n != 4) return fail(at, "expected a date as YYYY-MM-DD");
+    if (!expect_char('-', "after the year (YYYY-MM-DD)")) return false;
+    if (!read_uint(&m, &n) || n > 2) return fail(pos_, "expected a month (YYYY-MM-DD)");
+    if (!expect_char('-', "after the month (YYYY-MM-DD)")) return false;
+    if (!read_uint(&d, &n) || n > 2) return fail(pos_, "expected a day (YYYY-MM-DD)");
+    if (m < 1 || m > 12) return fail(at, "month " + std::to_string(m) + " is not in 1..12");
+    const unsigned dim = days_in_month(static_cast<int64_t>(y), static_cast<unsigned>(m));
+    if (d < 1 || d > dim)
+      return fail(at, "day " + std::to_string(d) + " is not in 1.." + std::to_string(dim) + " for month " +
+                          std::to_string(m));
+    *days = days_from_civil(static_cast<int64_t>(y), static_cast<unsigned>(m), static_cast<unsigned>(d));
+    return true;
+  };
+  // hh:mm[:ss[.fff]] -> ns since midnight.
+  auto read_tod = [&](int64_t* ns) {
+    uint64_t h = 0, m = 0, s = 0;
+    size_t n = 0;
+    const size_t at = pos_;
+    if (!read_uint(&h, &n) || n > 2) return fail(at, "expected a time of day as hh:mm:ss");
+    if (!expect_char(':', "after the hour (hh:mm:ss)")) return false;
+    if (!read_uint(&m, &n) || n > 2) return fail(pos_, "expected minutes (hh:mm:ss)");
+    int64_t frac = 0;
+    if (peek() == ':') {
+      ++pos_;
+      if (!read_uint(&s, &n) || n > 2) return fail(pos_, "expected seconds (hh:mm:ss)");
+      if (peek() == '.' && is_digit(peek(1))) {
+        ++pos_;
+        frac = read_fraction(kNsPerSec);
+      }
+    }
+    if (h > 23) return fail(at, "hour " + std::to_string(h) + " is not in 0..23");
+    if (m > 59) return fail(at, "minute " + std::to_string(m) + " is not in 0..59");
+    if (s > 59) return fail(at, "second " + std::to_string(s) + " is not in 0..59");
+    *ns = static_cast<int64_t>((h * 3600 + m * 60 + s)) * kNsPerSec + frac;
+    return true;
+  };
+
+  int64_t value = 0;
+  LiteralKind lit = LiteralKind::Time;
+  if (kind == TimePrefix::Duration) {
+    bool negative = false;
+    if (peek() == '-' || peek() == '+') {
+      negative = peek() == '-';
+      ++pos_;
+    }
+    if (!is_digit(peek())) {
+      fail(pos_, "expected a duration such as 1h2m3s4ms after '#'");
+    } else {
+      while (ok) {
+        uint64_t count = 0;
+        size_t n = 0;
+        const size_t num_at = pos_;
+        read_uint(&count, &n);
+        const bool has_frac = peek() == '.' && is_digit(peek(1));
+        const size_t frac_at = pos_;
+        if (has_frac) {
+          ++pos_;
+          while (pos_ < text_.size() && (is_digit(text_[pos_]) || text_[pos_] == '_')) ++pos_;
+        }
+        const size_t unit_at = pos_;
+        while (pos_ < text_.size() && std::isalpha(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+        const std::string unit = canon(text_.substr(unit_at, pos_ - unit_at));
+        int64_t unit_ns = 0;
+        if (unit == "D") unit_ns = kNsPerDay;
+        else if (unit == "H") unit_ns = 3600 * kNsPerSec;
+        else if (unit == "M") unit_ns = 60 * kNsPerSec;
+        else if (unit == "S") unit_ns = kNsPerSec;
+        else if (unit == "MS") unit_ns = 1'000'000;
+        else if (unit == "US") unit_ns = 1'000;
+        else if (unit == "NS") unit_ns = 1;
+        if (unit.empty()) {
+          fail(unit_at, "missing duration unit after '" + std::string(text_.substr(num_at, unit_at - num_at)) +
+                            "' (use d, h, m, s, ms, us or ns)");
+          break;
+        }
+        if (unit_ns == 0) {
+          fail(unit_at, "unknown duration unit '" + std::string(text_.substr(unit_at, pos_ - unit_at)) +
+                            "' (use d, h, m, s, ms, us or ns)");
+          break;
+        }
+        if (!add_checked(&value, count, unit_ns)) break;
+        if (has_frac) {
+          const size_t save = pos_;
+          pos_ = frac_at + 1;
+          const int64_t frac = read_fraction(unit_ns);
+          pos_ = save;
+          if (!add_checked(&value, 1, frac)) break;
+        }
+        if (peek() == '_' && is_digit(peek(1))) ++pos_;
+        if (!is_digit(peek())) break;
+      }
+    }
+    if (negative) value = -value;
+    lit = LiteralKind::Time;
+  } else if (kind == TimePrefix::Date) {
+    int64_t days = 0;
+    if (read_date(&days)) value = days * kNsPerDay;
+    lit = LiteralKind::Date;
+  } else if (kind == TimePrefix::TimeOfDay) {
+    read_tod(&value);
+    lit = LiteralKind::TimeOfDay;
+  } else {
+    int64_t days = 0, tod = 0;
+    if (read_date(&days) && expect_char('-', "between date and time (YYYY-MM-DD-hh:mm:ss)") && read_tod(&tod))
+      value = days * kNsPerDay + tod;
+    lit = LiteralKind::DateTime;
+  }
+  if (ok && pos_ < text_.size() && (is_ident_char(text_[pos_]) || text_[pos_] == '.' || text_[pos_] == ':'))
+    fail(pos_, std::string("unexpected '") + text_[pos_] + "'");
+  if (!ok) {
+    // Swallow the rest of the malformed literal so the parser does not see its pieces.
+    while (pos_ < text_.size() && (is_ident_char(text_[pos_]) || text_[pos_] == '.' || text_[pos_] == ':' ||
+                                   (text_[pos_] == '-' && is_digit(peek(1)))))
+      ++pos_;
+  }
+  Token tok = make(Tok::TimeLit, begin);
+  tok.lit = lit;
+  tok.time_ns = ok ? value : 0;
+  tok.is_long = is_long;
+  tok.prefix = prefix;
+  if (!ok) {
+    const bool duration = kind == TimePrefix::Duration;
+    error(duration ? "ST008" : "ST009", why_at, std::string(tok.text) + ": " + why);
+    tok.bad = true;
+  }
+  return tok;
+}
+
+std::vector<Token> lex_file(const SourceManager& sm, uint32_t file, DiagEngine& diags) {
+  Lexer lexer(sm, file, diags);
+  std::vector<Token> out;
+  for (;;) {
+    out.push_back(lexer.next());
+    if (out.back().kind == Tok::Eof) break;
+  }
+  return out;
+}
+
+}  // namespace plcfi::st
