@@ -117,7 +117,10 @@ class Parser {
   };
   struct DepthGuard {
     explicit DepthGuard(Parser& p) : p_(p) { exceeded = ++p_.depth_ > kMaxDepth; }
-    ~DepthGuard() { --p_.depth_; }
+    ~DepthGuard() {
+      // Once well out of the deep region, a later deep region is a new error.
+      if (--p_.depth_ < kMaxDepth / 2) p_.too_deep_reported_ = false;
+    }
     DepthGuard(const DepthGuard&) = delete;
     DepthGuard& operator=(const DepthGuard&) = delete;
     Parser& p_;
@@ -235,6 +238,8 @@ class Parser {
   void sync_decl();
   void skip_nested();
   void report_too_deep() {
+    if (too_deep_reported_) return;
+    too_deep_reported_ = true;
     error("ST117", cur().loc, "nesting too deep (more than " + std::to_string(kMaxDepth) +
                                   " levels of parentheses, blocks or types)");
   }
@@ -294,6 +299,7 @@ class Parser {
   size_t pos_ = 0;
   size_t last_error_pos_ = SIZE_MAX;
   int depth_ = 0;
+  bool too_deep_reported_ = false;
   std::vector<Frame> open_;
 };
 
@@ -455,7 +461,8 @@ ExprPtr Parser::parse_postfix() {
   for (;;) {
     if (at(Tok::Dot)) {
       advance();
-      if (at(Tok::Ident)) {
+      // Keywords are fine as member names after '.' (fb.METHOD, s.TYPE).
+      if (at(Tok::Ident) || (cur().kind > Tok::Ge && cur().kind < Tok::Count)) {
         const Token& t = advance();
         auto m = std::make_unique<MemberExpr>(e->loc);
         m->base = std::move(e);
@@ -1691,6 +1698,7 @@ std::unique_ptr<TestFile> Parser::parse_test_file() {
       error("ST130", cur().loc, "expected the test name as a string after TEST (e.g. TEST 'counts up'), found " +
                                     describe(la(1)));
       const Token& kw = advance();
+      if (at(Tok::Ident) && cur().loc.line == kw.loc.line) advance();  // an unquoted name
       TestCase tc;
       tc.loc = kw.loc;
       parse_test_case(tc, Tok::EndTest, "TEST");
