@@ -1,0 +1,271 @@
+// ST engine commands: check, run, test, disasm.
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <optional>
+
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "engine.hpp"
+#include "report/junit.hpp"
+#include "runtime/schedule.hpp"
+#include "test_runner.hpp"
+
+namespace po = boost::program_options;
+
+namespace plcfi::cli {
+
+namespace {
+
+// Parses args into vm; returns false when --help was printed.
+bool parse(const std::vector<std::string>& args, po::options_description& desc, po::variables_map& vm,
+           const char* usage_line, bool files = true) {
+  desc.add_options()("help,h", "show this help");
+  po::options_description all;
+  all.add(desc);
+  po::positional_options_description pos;
+  if (files) {
+    all.add_options()("files", po::value<std::vector<std::string>>(), "ST files");
+    pos.add("files", -1);
+  }
+  po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
+  po::notify(vm);
+  if (vm.count("help")) {
+    std::cout << "usage: " << usage_line << "\n\n" << desc << "\n";
+    return false;
+  }
+  return true;
+}
+
+std::vector<std::string> files_of(const po::variables_map& vm) {
+  return vm.count("files") ? vm["files"].as<std::vector<std::string>>() : std::vector<std::string>{};
+}
+
+// Compiles and prints diagnostics. Returns null after printing why.
+std::unique_ptr<st::Build> load(const std::vector<std::string>& files, const st::CompileOptions& opt, const char* cmd) {
+  if (files.empty()) {
+    std::cerr << "plcfi " << cmd << ": no input files\n";
+    return nullptr;
+  }
+  auto b = st::build_files(files, opt);
+  for (const auto& e : b->io_errors) std::cerr << e << "\n";
+  std::cerr << b->diags.render_all();
+  return b;
+}
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (c == '\n') out += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
+    else out += c;
+  }
+  return out;
+}
+
+std::string json_value(const st::Machine& m, const st::VarHandle& h) {
+  const st::Type* t = h.type;
+  if (h.is_bit || t->kind == st::TypeKind::Bool) return st::read_bool(m, h) ? "true" : "false";
+  if (t->is_integer() || t->is_bitstring()) return std::to_string(st::read_int(m, h));
+  if (t->is_real()) return fmt::format("{}", st::read_real(m, h));
+  return "\"" + json_escape(st::format(m, h)) + "\"";
+}
+
+}  // namespace
+
+int cmd_check(const std::vector<std::string>& args) {
+  po::options_description desc("plcfi check: compile ST files and report every error and warning");
+  desc.add_options()("no-warnings", "report errors only");
+  po::variables_map vm;
+  if (!parse(args, desc, vm, "plcfi check FILES... [--no-warnings]")) return 0;
+  st::CompileOptions opt;
+  opt.warnings = !vm.count("no-warnings");
+  opt.test_mode = true;  // test files may be checked too; their built-ins are then known
+  auto b = load(files_of(vm), opt, "check");
+  if (!b) return 2;
+  if (!b->io_errors.empty()) return 2;
+  size_t errors = b->diags.error_count(), warnings = b->diags.warning_count();
+  std::cout << fmt::format("{}: {} error(s), {} warning(s)\n", errors ? "FAILED" : "OK", errors, warnings);
+  return errors ? 1 : 0;
+}
+
+int cmd_disasm(const std::vector<std::string>& args) {
+  po::options_description desc("plcfi disasm: print the bytecode of ST files with their source lines");
+  po::variables_map vm;
+  if (!parse(args, desc, vm, "plcfi disasm FILES...")) return 0;
+  st::CompileOptions opt;
+  opt.warnings = false;
+  auto b = load(files_of(vm), opt, "disasm");
+  if (!b || !b->ok()) return 2;
+  std::cout << st::disassemble(*b->app, b.get());
+  return 0;
+}
+
+int cmd_run(const std::vector<std::string>& args) {
+  po::options_description desc("plcfi run: run ST programs in virtual time (the configuration's tasks, or one program)");
+  desc.add_options()
+      ("program", po::value<std::string>(), "program instance or type to run (without a CONFIGURATION)")
+      ("cycles", po::value<uint64_t>()->default_value(1), "number of base-tick cycles to run")
+      ("cycle-time", po::value<std::string>()->default_value("10ms"), "cycle time for a single program (e.g. 10ms)")
+      ("set", po::value<std::vector<std::string>>(), "PATH=VALUE before the first cycle (repeatable)")
+      ("print", po::value<std::vector<std::string>>(), "PATH to print at the end (repeatable)")
+      ("json", "print the result as JSON")
+      ("coverage", "print branch coverage per file")
+      ("budget", po::value<uint64_t>()->default_value(10'000'000), "loop iterations allowed per program call (watchdog)");
+  po::variables_map vm;
+  if (!parse(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json]")) return 0;
+  st::CompileOptions opt;
+  opt.warnings = false;
+  auto b = load(files_of(vm), opt, "run");
+  if (!b || !b->ok()) return 2;
+  const st::Application& app = *b->app;
+
+  rt::Schedule sched;
+  std::string err;
+  bool ok_sched;
+  if (app.has_configuration && !vm.count("program")) {
+    ok_sched = sched.from_configuration(app, &err);
+  } else {
+    int64_t cycle = 0;
+    if (!rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
+      std::cerr << "plcfi run: --cycle-time: " << err << "\n";
+      return 2;
+    }
+    ok_sched = sched.single_program(app, vm.count("program") ? vm["program"].as<std::string>() : "", cycle, &err);
+  }
+  if (!ok_sched) {
+    std::cerr << "plcfi run: " << err << "\n";
+    return 2;
+  }
+  st::Machine m(app);
+  m.set_budget(vm["budget"].as<uint64_t>());
+  if (vm.count("set")) {
+    for (const auto& s : vm["set"].as<std::vector<std::string>>()) {
+      auto eq = s.find('=');
+      if (eq == std::string::npos) {
+        std::cerr << "plcfi run: --set '" << s << "': expected PATH=VALUE\n";
+        return 2;
+      }
+      auto h = st::resolve(app, s.substr(0, eq), &err);
+      if (!h || !st::write_text(m, *h, s.substr(eq + 1), &err)) {
+        std::cerr << "plcfi run: --set: " << err << "\n";
+        return 2;
+      }
+    }
+  }
+  std::vector<st::VarHandle> prints;
+  if (vm.count("print")) {
+    for (const auto& p : vm["print"].as<std::vector<std::string>>()) {
+      auto h = st::resolve(app, p, &err);
+      if (!h) {
+        std::cerr << "plcfi run: --print: " << err << "\n";
+        return 2;
+      }
+      prints.push_back(*h);
+    }
+  }
+  uint64_t cycles = vm["cycles"].as<uint64_t>();
+  int status = 0;
+  std::string trap_text;
+  uint64_t done = 0;
+  for (uint64_t n = 0; n < cycles && status == 0; ++n) {
+    m.set_now(static_cast<int64_t>(n) * sched.tick_ns());
+    m.clear_taken();
+    sched.for_each_due(n, [&](const rt::ScheduledTask& t) {
+      for (size_t pi : t.programs) {
+        if (status) return;
+        const auto& inst = app.programs[pi];
+        if (!m.call(inst.pou->entry, inst.addr)) {
+          trap_text = st::describe_trap(app, m.trap()) + fmt::format(" (program {}, cycle {})", inst.name, n);
+          status = 1;
+        }
+      }
+    });
+    m.merge_coverage();
+    if (status == 0) ++done;
+  }
+  if (!trap_text.empty()) std::cerr << trap_text << "\n";
+  if (vm.count("json")) {
+    std::string out = fmt::format("{{\"cycles\": {}, \"time_ns\": {}, \"tick_ns\": {}, \"trap\": {}, \"values\": {{", done,
+                                  static_cast<int64_t>(done) * sched.tick_ns(), sched.tick_ns(),
+                                  trap_text.empty() ? "null" : "\"" + json_escape(trap_text) + "\"");
+    for (size_t i = 0; i < prints.size(); ++i)
+      out += fmt::format("{}\"{}\": {}", i ? ", " : "", json_escape(prints[i].path), json_value(m, prints[i]));
+    std::cout << out << "}}\n";
+  } else {
+    for (const auto& h : prints) std::cout << h.path << " = " << st::format(m, h) << "\n";
+  }
+  if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
+  return status;
+}
+
+int cmd_test(const std::vector<std::string>& args) {
+  po::options_description desc("plcfi test: run ST unit-test files (sources and test files in any order)");
+  desc.add_options()
+      ("junit", po::value<std::string>(), "write JUnit XML to this file")
+      ("coverage", "print branch coverage of the sources")
+      ("budget", po::value<uint64_t>()->default_value(100'000'000), "loop iterations allowed per test phase (watchdog)");
+  po::variables_map vm;
+  if (!parse(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage]")) return 0;
+  st::CompileOptions opt;
+  opt.test_mode = true;
+  opt.warnings = false;
+  auto b = load(files_of(vm), opt, "test");
+  if (!b || !b->ok()) return 2;
+  if (b->tests.empty()) {
+    std::cerr << "plcfi test: no test file among the inputs (a test file starts with TEST, SETUP or TEARDOWN)\n";
+    return 2;
+  }
+  st::Machine m(*b->app);
+  st::TestRunOptions ro;
+  ro.budget = vm["budget"].as<uint64_t>();
+  auto results = st::run_tests(*b->app, m, ro);
+  size_t passed = 0, failed = 0;
+  std::string current;
+  std::map<std::string, report::JunitSuite> suites;
+  std::vector<std::string> order;
+  for (const auto& r : results) {
+    if (r.file != current) {
+      current = r.file;
+      std::cout << "[" << r.file << "]\n";
+    }
+    if (r.passed) {
+      ++passed;
+      std::cout << "  PASS: " << r.name << "\n";
+    } else {
+      ++failed;
+      std::cout << "  FAIL: " << r.name << "\n    " << r.where << ": " << r.message << "\n";
+    }
+    if (!suites.count(r.file)) order.push_back(r.file);
+    auto& s = suites[r.file];
+    s.name = r.file;
+    report::JunitCase c;
+    c.classname = r.file;
+    c.name = r.name;
+    c.seconds = r.seconds;
+    if (!r.passed) {
+      c.outcome = report::JunitCase::Outcome::Fail;
+      c.message = r.message;
+      c.detail = r.where + ": " + r.message;
+    }
+    s.cases.push_back(c);
+  }
+  if (vm.count("coverage")) std::cout << st::coverage_report(*b->app, m.covered());
+  std::cout << passed << " passed, " << failed << " failed\n";
+  if (vm.count("junit")) {
+    std::vector<report::JunitSuite> v;
+    for (const auto& f : order) v.push_back(suites[f]);
+    std::string err;
+    if (!report::write_junit(vm["junit"].as<std::string>(), v, &err)) {
+      std::cerr << "plcfi test: " << err << "\n";
+      return 2;
+    }
+  }
+  return failed ? 1 : 0;
+}
+
+}  // namespace plcfi::cli

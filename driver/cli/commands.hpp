@@ -1,0 +1,14 @@
+// The plcfi subcommands. Each takes the arguments after its name and returns the exit status.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace plcfi::cli {
+
+int cmd_check(const std::vector<std::string>& args);
+int cmd_run(const std::vector<std::string>& args);
+int cmd_test(const std::vector<std::string>& args);
+int cmd_disasm(const std::vector<std::string>& args);
+
+}  // namespace plcfi::cli

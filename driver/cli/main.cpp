@@ -1,0 +1,73 @@
+// The plcfi executable: subcommand dispatch and option parsing. Each command is thin and
+// delegates to the libraries. Exit status: 0 success, 1 a test or check failed,
+// 2 bad usage or input.
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <boost/program_options.hpp>
+
+#include "commands.hpp"
+
+namespace po = boost::program_options;
+
+namespace {
+
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(const std::vector<std::string>& args);
+};
+
+const std::vector<Command>& commands() {
+  static const std::vector<Command> k = {
+      {"check", "compile ST files and print diagnostics", plcfi::cli::cmd_check},
+      {"run", "run ST programs in virtual time and print variables", plcfi::cli::cmd_run},
+      {"test", "run ST unit-test files", plcfi::cli::cmd_test},
+      {"disasm", "print the bytecode of ST files with their source lines", plcfi::cli::cmd_disasm},
+  };
+  return k;
+}
+
+void usage(std::ostream& os) {
+  os << "usage: plcfi <command> [options] [files...]\n\n"
+        "plcfi tests IEC 61131-3 Structured Text programs under faults.\n\ncommands:\n";
+  for (const auto& c : commands()) os << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary << "\n";
+  os << "\n'plcfi <command> --help' describes a command's options.\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    usage(std::cerr);
+    return 2;
+  }
+  std::string cmd = argv[1];
+  if (cmd == "--help" || cmd == "-h" || cmd == "help") {
+    usage(std::cout);
+    return 0;
+  }
+  if (cmd == "--version") {
+    std::cout << "plcfi 0.1.0\n";
+    return 0;
+  }
+  std::vector<std::string> args(argv + 2, argv + argc);
+  for (const auto& c : commands())
+    if (cmd == c.name) {
+      try {
+        return c.run(args);
+      } catch (const po::error& e) {
+        std::cerr << "plcfi " << cmd << ": " << e.what() << "\n(see 'plcfi " << cmd << " --help')\n";
+        return 2;
+      } catch (const std::exception& e) {
+        std::cerr << "plcfi " << cmd << ": " << e.what() << "\n";
+        return 2;
+      }
+    }
+  std::cerr << "plcfi: unknown command '" << cmd << "'\n\n";
+  usage(std::cerr);
+  return 2;
+}

@@ -1,0 +1,29 @@
+// JUnit XML writer (the format CI servers and test dashboards read).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace plcfi::report {
+
+struct JunitCase {
+  std::string classname;
+  std::string name;
+  double seconds = 0;
+  enum class Outcome { Pass, Fail, Skipped, Error } outcome = Outcome::Pass;
+  std::string message;  // failure/skip message (attribute)
+  std::string detail;   // element text
+  std::vector<std::pair<std::string, std::string>> properties;
+};
+
+struct JunitSuite {
+  std::string name;
+  std::vector<JunitCase> cases;
+};
+
+std::string junit_xml(const std::vector<JunitSuite>& suites);
+// Writes atomically (temporary file + rename). Returns false and fills err on failure.
+bool write_junit(const std::string& path, const std::vector<JunitSuite>& suites, std::string* err);
+std::string xml_escape(const std::string& s);
+
+}  // namespace plcfi::report

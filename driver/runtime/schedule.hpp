@@ -1,0 +1,46 @@
+// Cyclic task schedule: which program instances run at which base tick. From the
+// CONFIGURATION's tasks (base tick = greatest common divisor of the intervals, higher
+// priority = lower PRIORITY number first) or from one program and a cycle time.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vm/program.hpp"
+
+namespace plcfi::rt {
+
+struct ScheduledTask {
+  std::string name;
+  int64_t interval_ns = 0;
+  int64_t priority = 0;
+  std::vector<size_t> programs;  // indices into Application::programs
+};
+
+class Schedule {
+ public:
+  // From the application's configuration. Fails (returns false, err) without tasks.
+  bool from_configuration(const st::Application& app, std::string* err);
+  // One program instance (by instance or type name) every cycle_ns.
+  bool single_program(const st::Application& app, const std::string& program, int64_t cycle_ns, std::string* err);
+
+  int64_t tick_ns() const { return tick_ns_; }
+  const std::vector<ScheduledTask>& tasks() const { return tasks_; }
+  // Tasks due at base tick n (n = 0 is the first scan), in priority order.
+  template <class F>
+  void for_each_due(uint64_t n, F&& f) const {
+    for (const auto& t : tasks_)
+      if (n % static_cast<uint64_t>(t.interval_ns / tick_ns_) == 0) f(t);
+  }
+
+ private:
+  void finish();
+  int64_t tick_ns_ = 0;
+  std::vector<ScheduledTask> tasks_;
+};
+
+// Parses "10ms", "1s", "500us", "2m", "1h30m", "T#10ms" into nanoseconds.
+bool parse_duration(const std::string& text, int64_t* ns, std::string* err);
+
+}  // namespace plcfi::rt

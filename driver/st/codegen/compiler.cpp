@@ -1,0 +1,616 @@
+// Compiler driver: indexing order, POU bodies, code emission, frame finalization,
+// configuration (tasks and program instances), test fixtures and the final link.
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+
+#include "compiler_impl.hpp"
+#include "syntax/parser.hpp"
+
+namespace plcfi::st {
+
+// ------------------------------------------------------------------ Application
+
+SourceLoc Application::loc_of(uint32_t pc) const {
+  auto it = std::upper_bound(lines.begin(), lines.end(), pc,
+                             [](uint32_t v, const std::pair<uint32_t, SourceLoc>& e) { return v < e.first; });
+  if (it == lines.begin()) return {};
+  return std::prev(it)->second;
+}
+
+std::string Application::where(SourceLoc loc) const {
+  std::string f = loc.file < file_paths.size() ? file_paths[loc.file] : "<input>";
+  if (!loc.valid()) return f;
+  return f + ":" + std::to_string(loc.line) + ":" + std::to_string(loc.col);
+}
+
+PouInfo* Application::find_pou(std::string_view name) const {
+  for (const auto& p : pous)
+    if (iequals(p->name, name)) return p.get();
+  return nullptr;
+}
+
+const ImageArea* Application::image(char area) const {
+  switch (area) {
+    case 'I': case 'i': return &image_i;
+    case 'Q': case 'q': return &image_q;
+    case 'M': case 'm': return &image_m;
+    default: return nullptr;
+  }
+}
+
+Symbol* PouInfo::find_var(std::string_view n) const {
+  for (const auto& v : vars)
+    if (iequals(v->name, n)) return v.get();
+  return base ? base->find_var(n) : nullptr;
+}
+
+PouInfo* PouInfo::find_method(std::string_view n) const {
+  for (const auto& m : methods)
+    if (iequals(m->name, n)) return m.get();
+  if (base) return base->find_method(n);
+  for (auto* i : interfaces)
+    if (PouInfo* m = i->find_method(n)) return m;
+  return nullptr;
+}
+
+namespace detail {
+
+uint32_t storage_index(Storage s) { return static_cast<uint32_t>(s); }
+
+Op num_op(Op i8_variant, Storage s) {
+  constexpr uint32_t stride = static_cast<uint32_t>(Op::ADD_I16) - static_cast<uint32_t>(Op::ADD_I8);
+  return static_cast<Op>(static_cast<uint32_t>(i8_variant) + storage_index(s) * stride);
+}
+
+Op int_op(Op i8_variant, Storage s) {
+  constexpr uint32_t stride = static_cast<uint32_t>(Op::MOD_I16) - static_cast<uint32_t>(Op::MOD_I8);
+  return static_cast<Op>(static_cast<uint32_t>(i8_variant) + storage_index(s) * stride);
+}
+
+Op cvt_op(Storage from, Storage to) {
+  return static_cast<Op>(static_cast<uint32_t>(num_op(Op::CVT_I8_I8, from)) + storage_index(to));
+}
+
+Op mov_op(uint32_t size) {
+  switch (size) {
+    case 1: return Op::MOV1;
+    case 2: return Op::MOV2;
+    case 4: return Op::MOV4;
+    case 8: return Op::MOV8;
+    default: return Op::MOVN;
+  }
+}
+
+ValueKind value_kind(const Type* t) {
+  switch (t->kind) {
+    case TypeKind::Bool: return ValueKind::Bool;
+    case TypeKind::Time: case TypeKind::LTime: return ValueKind::Time;
+    case TypeKind::Date: return ValueKind::Date;
+    case TypeKind::TimeOfDay: return ValueKind::Tod;
+    case TypeKind::DateTime: return ValueKind::Dt;
+    case TypeKind::String: case TypeKind::WString: return ValueKind::String;
+    case TypeKind::Ref: case TypeKind::Interface: return ValueKind::Ref;
+    default: break;
+  }
+  switch (t->storage()) {
+    case Storage::I8: return ValueKind::I8;
+    case Storage::I16: return ValueKind::I16;
+    case Storage::I32: return ValueKind::I32;
+    case Storage::I64: return ValueKind::I64;
+    case Storage::U8: return ValueKind::U8;
+    case Storage::U16: return ValueKind::U16;
+    case Storage::U32: return ValueKind::U32;
+    case Storage::U64: return ValueKind::U64;
+    case Storage::F32: return ValueKind::F32;
+    case Storage::F64: return ValueKind::F64;
+    default: return ValueKind::U8;
+  }
+}
+
+namespace {
+uint32_t align_up(uint32_t v, uint32_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
+template <class T>
+void put(uint8_t* p, T v) {
+  std::memcpy(p, &v, sizeof(T));
+}
+}  // namespace
+
+Compiler::Compiler(const SourceManager& sm, DiagEngine& diags, const CompileOptions& opt)
+    : sm_(sm), diags_(diags), opt_(opt) {}
+
+// ------------------------------------------------------------------ emission
+
+void Compiler::emit(Op op, std::initializer_list<Arg> args) { emit_list(op, std::vector<Arg>(args)); }
+
+void Compiler::def(Slot dst) {
+  b_->last_def = dst;
+  // The instruction just emitted starts at code.size() - 1 - operands.
+  b_->last_def_pos = b_->last_instr;
+}
+
+bool Compiler::retarget(Slot from, Slot to) {
+  if (b_->last_def_pos != b_->last_instr || b_->last_label_pos > b_->last_instr) return false;
+  if (b_->last_def.off != from.off || b_->last_def.kind != from.kind || from.kind != SK::Temp) return false;
+  uint32_t word = b_->last_def_pos + 1;
+  auto it = std::find_if(b_->slot_fix.begin(), b_->slot_fix.end(), [&](const auto& e) { return e.first == word; });
+  if (it != b_->slot_fix.end()) b_->slot_fix.erase(it);
+  b_->code[word] = to.off;
+  if (to.kind != SK::Var) b_->slot_fix.emplace_back(word, to.kind);
+  b_->last_def_pos = UINT32_MAX;
+  return true;
+}
+
+void Compiler::emit_list(Op op, const std::vector<Arg>& args) {
+  auto& code = b_->code;
+  b_->last_instr = static_cast<uint32_t>(code.size());
+  code.push_back(static_cast<uint32_t>(op));
+  for (const Arg& a : args) {
+    switch (a.k) {
+      case Arg::K::Imm: break;
+      case Arg::K::Slot:
+        if (a.sk != SK::Var) b_->slot_fix.emplace_back(static_cast<uint32_t>(code.size()), a.sk);
+        break;
+      case Arg::K::Target: b_->target_fix.emplace_back(static_cast<uint32_t>(code.size()), a.v); break;
+      case Arg::K::Entry: b_->entry_fix.emplace_back(static_cast<uint32_t>(code.size()), a.pou); break;
+    }
+    code.push_back(a.k == Arg::K::Slot || a.k == Arg::K::Imm ? a.v : 0);
+  }
+}
+
+Label Compiler::new_label() {
+  b_->label_pos.push_back(UINT32_MAX);
+  return Label{static_cast<uint32_t>(b_->label_pos.size() - 1)};
+}
+
+void Compiler::bind(Label l) {
+  b_->label_pos[l.id] = static_cast<uint32_t>(b_->code.size());
+  b_->last_label_pos = static_cast<uint32_t>(b_->code.size());
+}
+
+void Compiler::mark(SourceLoc loc) {
+  if (!loc.valid() || !b_) return;
+  auto& lines = b_->lines;
+  uint32_t pc = static_cast<uint32_t>(b_->code.size());
+  if (!lines.empty() && lines.back().first == pc) {
+    lines.back().second = loc;
+    return;
+  }
+  lines.emplace_back(pc, loc);
+}
+
+Slot Compiler::temp(uint32_t size, uint32_t align) {
+  uint32_t off = align_up(b_->temp_top, align);
+  b_->temp_top = off + size;
+  b_->temp_max = std::max(b_->temp_max, b_->temp_top);
+  return Slot{off, SK::Temp};
+}
+
+Slot Compiler::konst_bytes(const void* data, uint32_t size, uint32_t align) {
+  std::string key(static_cast<const char*>(data), size);
+  auto it = b_->const_index.find({key, align});
+  if (it != b_->const_index.end()) return Slot{it->second, SK::Const};
+  uint32_t off = align_up(static_cast<uint32_t>(b_->consts.size()), std::min<uint32_t>(align, 8));
+  b_->consts.resize(off + size, 0);
+  std::memcpy(b_->consts.data() + off, data, size);
+  b_->const_index[{key, align}] = off;
+  return Slot{off, SK::Const};
+}
+
+Slot Compiler::konst(const Type* t, const ConstV& c, SourceLoc loc) {
+  std::vector<uint8_t> buf(t->size ? t->size : 1, 0);
+  write_const(buf.data(), t, c, loc);
+  return konst_bytes(buf.data(), static_cast<uint32_t>(buf.size()), t->align);
+}
+
+Slot Compiler::konst_i64(int64_t v) { return konst_bytes(&v, 8, 8); }
+Slot Compiler::konst_u32(uint32_t v) { return konst_bytes(&v, 4, 4); }
+
+// ------------------------------------------------------------------ POU bodies
+
+void Compiler::compile_pou(PouInfo* p) {
+  if (p->compiled) return;
+  compiling_.push_back(p);
+  Body* saved_b = b_;
+  uint32_t saved_file = file_;
+  b_ = nullptr;
+  file_ = p->file;
+  const Pou* decl = p->decl;
+
+  declare_pou(p);
+  if (p->kind == PouKind::Interface || (p->kind == PouKind::Method && decl && !decl->has_body) ||
+      (p->kind == PouKind::Method && p->owner && p->owner->kind == PouKind::Interface)) {
+    p->compiled = true;
+    compiling_.pop_back();
+    b_ = saved_b;
+    file_ = saved_file;
+    return;
+  }
+  if (p->kind == PouKind::Method && p->owner) ensure_compiled(p->owner, decl ? decl->loc : SourceLoc{});
+
+  auto body = std::make_unique<Body>();
+  b_ = body.get();
+  b_->pou = p;
+  b_->file = p->file;
+  b_->vars_end = p->frame_size;
+  b_->temp_top = 0;
+  for (const auto& v : p->vars) b_->locals[canon(v->name)] = v.get();
+  if (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) {
+    b_->this_type = p->type;
+    for (PouInfo* base = p->base; base; base = base->base)
+      for (const auto& v : base->vars)
+        if (!b_->locals.count(canon(v->name))) b_->locals[canon(v->name)] = v.get();
+  }
+  if (p->kind == PouKind::Method && p->owner && p->owner->type) {
+    b_->is_method = true;
+    b_->this_type = p->owner->type;
+    for (PouInfo* o = p->owner; o; o = o->base)
+      for (const auto& v : o->vars) {
+        std::string key = canon(v->name);
+        if (b_->locals.count(key)) continue;
+        auto s = std::make_unique<Symbol>(*v);
+        s->where = v->where == Where::Frame ? Where::This : v->where;
+        if (v->where == Where::InOut) {
+          // In-out of the owner seen from a method: a pointer in the instance.
+          s->where = Where::This;
+          s->type = tt_->ref_to(v->type);
+        }
+        b_->locals[key] = s.get();
+        b_->owned.push_back(std::move(s));
+      }
+  }
+
+  std::vector<uint32_t> entries;
+  // Prologue.
+  if (p->kind == PouKind::Method) {
+    emit(Op::ENTER, {0u});
+    b_->template_fix.push_back(static_cast<uint32_t>(b_->code.size() - 1) | 0x80000000u);  // frame size
+  }
+  if (opt_.test_mode && (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program))
+    emit(Op::FBENTER, {});
+  if (opt_.test_mode && p->kind == PouKind::Function && !p->is_stdlib) {
+    uint32_t rsize = p->result ? p->result->size : 0;
+    p->mock_addr = alloc(8 + rsize, 8);
+    emit(Op::FNMOCK, {p->mock_addr, p->result_offset, rsize});
+  }
+  bool has_tmpl = p->kind == PouKind::Method || ((p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) &&
+                                                 p->init_from < b_->vars_end);
+  if (has_tmpl) {
+    emit(Op::INITBLK, {p->init_from, 0u, 0u});
+    b_->template_fix.push_back(static_cast<uint32_t>(b_->code.size() - 2));
+    b_->template_fix.push_back(static_cast<uint32_t>(b_->code.size() - 1) | 0x40000000u);  // length
+  }
+  entries.push_back(0);
+  if (decl) stmts(decl->body);
+  mark(decl ? decl->end_loc : SourceLoc{});
+  emit(Op::RET, {});
+  finish_body(*body, p, &entries);
+  p->entry = entries[0];
+  p->compiled = true;
+  compiling_.pop_back();
+
+  // Warnings: variables never used (not parameters, not stdlib).
+  if (opt_.warnings && !p->is_stdlib) {
+    for (const auto& v : p->vars) {
+      if (v->reads || v->writes) continue;
+      if (v->section != VarSection::Var && v->section != VarSection::Temp) continue;
+      if (v->where == Where::Abs || v->where == Where::AbsBit) continue;  // I/O mapping
+      if (p->kind == PouKind::Program || p->kind == PouKind::FunctionBlock) {
+        // Instance variables are observable through paths and by test files; only
+        // temporaries are certainly dead.
+        if (v->section != VarSection::Temp) continue;
+      }
+      diags_.warning("ST400", v->loc, "variable '" + v->name + "' is declared but never used");
+    }
+  }
+  bodies_.push_back(std::move(body));
+  b_ = saved_b;
+  file_ = saved_file;
+}
+
+// Lays out constants and temporaries, patches operands and appends the body to the code.
+void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) {
+  uint32_t const_base = align_up(b.vars_end, 8);
+  uint32_t temp_base = align_up(const_base + static_cast<uint32_t>(b.consts.size()), 8);
+  uint32_t frame_size = align_up(temp_base + b.temp_max, 8);
+  for (auto [idx, kind] : b.slot_fix) b.code[idx] += kind == SK::Const ? const_base : temp_base;
+  p->frame_size = frame_size;
+
+  // The frame's initial image: header, variables' initial values, constants.
+  std::vector<uint8_t> image(frame_size, 0);
+  if (p->base && p->base->type) std::copy(p->base->type->init.begin(), p->base->type->init.end(), image.begin());
+  if (p->type_id) put<uint16_t>(image.data(), static_cast<uint16_t>(p->type_id));
+  for (const auto& v : p->vars)
+    if (v->where == Where::Frame) write_init(image, v->offset, v->type, v->decl ? v->decl->init.get() : nullptr, p->file);
+  std::copy(b.consts.begin(), b.consts.end(), image.begin() + const_base);
+
+  if (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) {
+    p->type->size = frame_size;
+    p->type->align = 8;
+    p->type->init = image;
+    p->tmpl_from = p->init_from;
+    p->tmpl_to = b.vars_end;
+  } else if (p->kind == PouKind::Function) {
+    p->tmpl_from = 0;
+    p->tmpl_to = temp_base;
+  } else {
+    p->tmpl_from = p->init_from;
+    p->tmpl_to = temp_base;
+  }
+  p->init_to = temp_base;
+  if (p->tmpl_to > p->tmpl_from) {
+    p->template_addr = alloc(p->tmpl_to - p->tmpl_from, 8);
+    std::copy(image.begin() + p->tmpl_from, image.begin() + p->tmpl_to,
+              app_->init_image.begin() + p->template_addr);
+  }
+  for (uint32_t f : b.template_fix) {
+    if (f & 0x80000000u) b.code[f & 0x3fffffffu] = frame_size;
+    else if (f & 0x40000000u) b.code[f & 0x3fffffffu] = p->tmpl_to - p->tmpl_from;
+    else b.code[f] = p->template_addr;
+  }
+
+  uint32_t base = static_cast<uint32_t>(app_->code.size());
+  for (auto [idx, label] : b.target_fix) b.code[idx] = base + b.label_pos[label];
+  for (auto [idx, pou] : b.entry_fix) entry_fix_.emplace_back(base + idx, pou);
+  for (auto [pc, loc] : b.lines) app_->lines.emplace_back(base + pc, loc);
+  app_->code.insert(app_->code.end(), b.code.begin(), b.code.end());
+  if (entries)
+    for (auto& e : *entries) e += base;
+}
+
+// One TEST becomes a PROGRAM-like POU whose variables are SETUP's and the test's own;
+// its three bodies (setup, test, teardown) share that frame.
+void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
+  auto pi = std::make_unique<PouInfo>();
+  PouInfo* p = pi.get();
+  p->kind = PouKind::Program;
+  p->name = "TEST '" + tc.name + "'";
+  p->file = tf.file;
+  p->type = tt_->make(TypeKind::Pou, p->name);
+  p->type->pou = p;
+  p->type_id = next_type_id_++;
+  if (tf.setup)
+    for (const auto& blk : tf.setup->var_blocks) p->blocks.push_back(&blk);
+  for (const auto& blk : tc.var_blocks) p->blocks.push_back(&blk);
+  p->declared = true;
+  Body* saved_b = b_;
+  b_ = nullptr;
+  file_ = tf.file;
+  declare_vars(p);
+
+  auto body = std::make_unique<Body>();
+  b_ = body.get();
+  b_->pou = p;
+  b_->file = tf.file;
+  b_->vars_end = p->frame_size;
+  b_->this_type = p->type;
+  for (const auto& v : p->vars) b_->locals[canon(v->name)] = v.get();
+  std::vector<uint32_t> entries;
+  const StmtList* parts[3] = {tf.setup ? &tf.setup->body : nullptr, &tc.body, tf.teardown ? &tf.teardown->body : nullptr};
+  for (const StmtList* part : parts) {
+    entries.push_back(static_cast<uint32_t>(b_->code.size()));
+    if (part) stmts(*part);
+    emit(Op::RET, {});
+  }
+  finish_body(*body, p, &entries);
+  p->compiled = true;
+  bodies_.push_back(std::move(body));
+  b_ = saved_b;
+
+  TestEntry te;
+  te.name = tc.name;
+  te.loc = tc.loc;
+  te.instance_addr = alloc(p->frame_size, 8);
+  std::copy(p->type->init.begin(), p->type->init.end(), app_->init_image.begin() + te.instance_addr);
+  te.setup_entry = entries[0];
+  te.body_entry = entries[1];
+  te.teardown_entry = entries[2];
+  te.has_setup = tf.setup.has_value();
+  te.has_teardown = tf.teardown.has_value();
+  app_->tests.push_back(te);
+  app_->pous.push_back(std::move(pi));
+}
+
+// ------------------------------------------------------------------ the whole run
+
+std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUnit*>& units,
+                                           const std::vector<const TestFile*>& tests) {
+  app_ = std::make_unique<Application>();
+  app_->types = std::make_unique<TypeTable>();
+  tt_ = app_->types.get();
+  {
+    Type* n = tt_->make(TypeKind::Ref, "NULL");
+    n->size = 4;
+    n->align = 4;
+    n->target = elem(TypeKind::Void);
+    n->init.assign(4, 0);
+    null_type_ = n;
+  }
+  for (size_t i = 0; i < sm_.size(); ++i) app_->file_paths.push_back(sm_.file(static_cast<uint32_t>(i)).path);
+
+  alloc(16, 16);  // address 0 stays invalid: it is the null reference
+  app_->image_i = {'I', alloc(opt_.image_size_i, 8), opt_.image_size_i};
+  app_->image_q = {'Q', alloc(opt_.image_size_q, 8), opt_.image_size_q};
+  app_->image_m = {'M', alloc(opt_.image_size_m, 8), opt_.image_size_m};
+
+  std::vector<const CompilationUnit*> all = units;
+  for (const auto* t : tests) all.push_back(&t->decls);
+  for (const auto* u : all) index_unit(*u, u->file < sm_.size() && sm_.file(u->file).path == "<stdlib>");
+
+  // Inheritance and interfaces.
+  auto link = [&](PouInfo* p) {
+    const Pou* d = p->decl;
+    if (!d) return;
+    if (d->extends) {
+      auto it = pous_.find(canon(d->extends->text));
+      if (it == pous_.end() || (p->kind == PouKind::FunctionBlock && it->second->kind != PouKind::FunctionBlock) ||
+          (p->kind == PouKind::Interface && it->second->kind != PouKind::Interface)) {
+        diags_.error("ST226", d->extends->loc, "'" + d->extends->text + "' is not a " +
+                                                   (p->kind == PouKind::Interface ? "n interface" : " function block"));
+      } else if (p->kind == PouKind::Interface) {
+        p->interfaces.push_back(it->second);
+      } else {
+        p->base = it->second;
+      }
+    }
+    for (const auto& i : d->implements) {
+      auto it = pous_.find(canon(i.text));
+      if (it == pous_.end() || it->second->kind != PouKind::Interface) {
+        diags_.error("ST226", i.loc, "'" + i.text + "' is not an interface");
+        continue;
+      }
+      p->interfaces.push_back(it->second);
+    }
+  };
+  for (const auto& p : app_->pous) link(p.get());
+  // Inheritance cycles would make layouts infinite.
+  for (const auto& p : app_->pous) {
+    size_t depth = 0;
+    for (PouInfo* b = p->base; b; b = b->base)
+      if (++depth > app_->pous.size()) {
+        diags_.error("ST226", p->decl->loc, "'" + p->name + "' inherits from itself");
+        p->base = nullptr;
+        break;
+      }
+  }
+
+  // Globals: global variable lists (scope: file stem), configurations and resources.
+  for (const auto* u : all) {
+    std::string stem = std::filesystem::path(sm_.file(u->file).path).stem().string();
+    declare_globals(u->globals, stem, u->file);
+    for (const auto& c : u->configs) {
+      declare_globals(c.globals, c.name.text, u->file);
+      for (const auto& r : c.resources) declare_globals(r.globals, r.name.text, u->file);
+    }
+  }
+
+  // Every POU is compiled (and so checked), used or not.
+  for (size_t i = 0; i < app_->pous.size(); ++i) ensure_compiled(app_->pous[i].get(), app_->pous[i]->decl->loc);
+  for (size_t i = 0; i < all_methods_.size(); ++i) ensure_compiled(all_methods_[i], all_methods_[i]->decl->loc);
+
+  // Interface conformance: every method of every implemented interface must exist.
+  for (const auto& p : app_->pous) {
+    if (p->kind != PouKind::FunctionBlock || p->decl->is_abstract) continue;
+    std::function<void(const PouInfo*)> check = [&](const PouInfo* itf) {
+      for (const auto& m : itf->methods) {
+        PouInfo* impl = nullptr;
+        for (PouInfo* f = p.get(); f && !impl; f = f->base)
+          for (const auto& fm : f->methods)
+            if (iequals(fm->name, m->name) && fm->decl->has_body) impl = fm.get();
+        if (!impl) {
+          std::string what = m->property ? "property '" + m->property->name.text + "'" : "method '" + m->name + "'";
+          diags_.error("ST225", p->decl->name.loc, p->name + " does not implement " + what + " of interface " + itf->name);
+        } else if (impl->inputs.size() != m->inputs.size() || !same_type(impl->result, m->result)) {
+          diags_.error("ST225", impl->decl->name.loc, "method " + p->name + "." + impl->name + " does not match the signature in interface " + itf->name);
+        }
+      }
+      for (const auto* e : itf->interfaces) check(e);
+    };
+    for (const auto* itf : p->interfaces) check(itf);
+  }
+
+  // Configuration: tasks and program instances.
+  for (const auto* u : units) {
+    for (const auto& c : u->configs) {
+      app_->has_configuration = true;
+      for (const auto& r : c.resources) {
+        for (const auto& t : r.tasks) {
+          TaskInfo ti;
+          ti.name = t.name.text;
+          ti.loc = t.loc;
+          if (t.single) diags_.error("ST235", t.single->loc, "event tasks (SINGLE) are not supported; use INTERVAL");
+          if (!t.interval) {
+            diags_.error("ST227", t.loc, "task '" + t.name.text + "' needs an INTERVAL");
+            continue;
+          }
+          auto iv = const_eval(*t.interval, u->file);
+          if (iv && iv->k == ConstV::K::Int) ti.interval_ns = iv->i;
+          if (ti.interval_ns <= 0) {
+            diags_.error("ST227", t.interval->loc, "task interval must be a positive duration");
+            continue;
+          }
+          if (t.priority) {
+            auto pr = const_int(*t.priority, u->file);
+            if (pr) ti.priority = *pr;
+          }
+          for (const auto& other : app_->tasks)
+            if (iequals(other.name, ti.name)) diags_.error("ST202", t.name.loc, "task '" + ti.name + "' is declared twice");
+          app_->tasks.push_back(ti);
+        }
+        for (const auto& pd : r.programs) {
+          auto it = pous_.find(canon(pd.type.text));
+          if (it == pous_.end() || it->second->kind != PouKind::Program) {
+            diags_.error("ST227", pd.type.loc, "'" + pd.type.text + "' is not a PROGRAM");
+            continue;
+          }
+          if (!pd.args.empty()) diags_.error("ST235", pd.loc, "program arguments in the configuration are not supported; use VAR_EXTERNAL or located variables");
+          ProgramInstance pi;
+          pi.name = pd.instance.text;
+          pi.pou = it->second;
+          for (const auto& other : app_->programs)
+            if (iequals(other.name, pi.name)) diags_.error("ST202", pd.instance.loc, "program instance '" + pi.name + "' is declared twice");
+          if (pd.task) {
+            bool found = false;
+            for (size_t k = 0; k < app_->tasks.size(); ++k)
+              if (iequals(app_->tasks[k].name, pd.task->text)) {
+                found = true;
+                app_->tasks[k].programs.push_back(app_->programs.size());
+                pi.task = app_->tasks[k].name;
+              }
+            if (!found) {
+              diags_.error("ST227", pd.task->loc, "unknown task '" + pd.task->text + "'");
+              continue;
+            }
+          }
+          app_->programs.push_back(pi);
+        }
+      }
+    }
+  }
+  if (!app_->has_configuration && !opt_.test_mode) {
+    for (const auto& p : app_->pous)
+      if (p->kind == PouKind::Program && !p->is_stdlib) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
+  }
+  for (auto& pi : app_->programs) {
+    if (!pi.pou->compiled) continue;
+    pi.addr = alloc(pi.pou->frame_size, 8);
+    std::copy(pi.pou->type->init.begin(), pi.pou->type->init.end(), app_->init_image.begin() + pi.addr);
+    for (const auto& v : pi.pou->vars)
+      if (v->retain && v->where == Where::Frame) app_->retain_ranges.emplace_back(pi.addr + v->offset, v->type->size);
+  }
+
+  for (const auto* tf : tests)
+    for (const auto& tc : tf->tests) compile_test(*tf, tc);
+
+  // Method frames live on a small stack of their own.
+  app_->mstack_size = 64 * 1024;
+  app_->mstack_addr = alloc(app_->mstack_size, 16);
+
+  // Link: entries of called POUs, and the dispatch table.
+  for (auto [idx, pou] : entry_fix_) app_->code[idx] = pou->entry;
+  app_->n_types = next_type_id_;
+  app_->vtable.assign(static_cast<size_t>(selectors_.size()) * app_->n_types, 0);
+  for (const auto& p : app_->pous) {
+    if (!p->type_id) continue;
+    for (const PouInfo* f = p.get(); f; f = f->base)
+      for (const auto& m : f->methods) {
+        if (!m->decl || !m->decl->has_body || !m->compiled) continue;
+        uint32_t& slot = app_->vtable[static_cast<size_t>(m->selector) * app_->n_types + p->type_id];
+        if (slot == 0) slot = m->entry;  // the most derived implementation wins
+      }
+  }
+  if (diags_.has_errors()) return nullptr;
+  return std::move(app_);
+}
+
+}  // namespace detail
+
+std::unique_ptr<Application> compile(const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
+                                     const std::vector<const TestFile*>& tests, DiagEngine& diags,
+                                     const CompileOptions& options) {
+  detail::Compiler c(sm, diags, options);
+  return c.run(units, tests);
+}
+
+}  // namespace plcfi::st

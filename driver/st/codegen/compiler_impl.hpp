@@ -1,0 +1,271 @@
+// Internal state of the ST compiler, shared by its translation units (declarations,
+// expressions, statements, calls). Not part of the engine's public interface.
+//
+// The compiler works in two stages over the AST: declarations (types, POU signatures,
+// layouts, globals) are indexed first; then each POU body is type-checked and translated
+// to bytecode in one walk (like Lua's and Wirth's compilers), POUs compiled on demand so
+// that an FB's instance size or a function's frame size is known before a caller needs it.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "codegen/compiler.hpp"
+#include "vm/natives.hpp"
+#include "vm/vm.hpp"
+
+namespace plcfi::st::detail {
+
+// A frame operand: a declared variable's offset, a temporary, or a constant-pool entry.
+// Temporaries and constants get their final offsets when the body is finished
+// (frame layout: [variables][constants][temporaries]).
+enum class SK : uint8_t { Var, Temp, Const };
+struct Slot {
+  uint32_t off = 0;
+  SK kind = SK::Var;
+  Slot plus(uint32_t d) const { return Slot{off + d, kind}; }
+};
+
+// One instruction operand word.
+struct Arg {
+  enum class K : uint8_t { Imm, Slot, Target, Entry } k = K::Imm;
+  uint32_t v = 0;
+  SK sk = SK::Var;
+  PouInfo* pou = nullptr;
+  Arg(uint32_t x) : v(x) {}  // NOLINT: immediates read naturally at call sites
+  Arg(int x) : v(static_cast<uint32_t>(x)) {}  // NOLINT
+  Arg(Slot s) : k(K::Slot), v(s.off), sk(s.kind) {}  // NOLINT
+  static Arg target(uint32_t label) {
+    Arg a(label);
+    a.k = K::Target;
+    return a;
+  }
+  static Arg entry(PouInfo* p) {
+    Arg a(0u);
+    a.k = K::Entry;
+    a.pou = p;
+    return a;
+  }
+};
+
+// A compile-time constant (literals, CONSTANT variables, folded expressions).
+struct ConstV {
+  enum class K : uint8_t { None, Int, Real, Bool, Str } k = K::None;
+  int64_t i = 0;
+  double r = 0;
+  std::string s;
+};
+
+// An rvalue: a constant, or a frame slot holding the value. type == null with a constant
+// of kind Int/Real is an untyped literal that adapts to its context (IEC ANY_INT/ANY_REAL).
+struct Val {
+  const Type* type = nullptr;
+  bool ok = true;
+  bool is_const = false;
+  ConstV c;
+  Slot slot;
+};
+
+// An lvalue.
+struct Place {
+  enum class K : uint8_t { Frame, Abs, AbsBit, Ind, FrameIdx, Bit } k = K::Frame;
+  const Type* type = nullptr;
+  uint32_t off = 0;   // Frame: offset; Abs/AbsBit: address; Ind: displacement; FrameIdx: array offset
+  SK sk = SK::Var;    // Frame/FrameIdx: what off is relative to
+  Slot ptr;           // Ind: slot holding the address
+  Slot idx;           // FrameIdx: DINT index slot
+  int32_t lo = 0;     // FrameIdx
+  uint32_t count = 0; // FrameIdx
+  uint8_t bit = 0;    // AbsBit, Bit
+  std::shared_ptr<Place> inner;  // Bit: the word
+  bool readonly = false;
+  const Symbol* sym = nullptr;
+  bool ok = true;
+};
+
+struct Label {
+  uint32_t id;
+};
+
+struct Body {
+  PouInfo* pou = nullptr;
+  uint32_t file = 0;
+  std::vector<uint32_t> code;
+  std::vector<std::pair<uint32_t, SourceLoc>> lines;
+  std::vector<uint32_t> label_pos;                         // label id -> body-relative pc
+  std::vector<std::pair<uint32_t, uint32_t>> target_fix;   // (code index, label id)
+  std::vector<std::pair<uint32_t, SK>> slot_fix;           // (code index, kind) for Temp/Const
+  std::vector<std::pair<uint32_t, PouInfo*>> entry_fix;    // (code index, POU) -> entry
+  std::vector<uint32_t> template_fix;                      // code index -> this POU's template address
+  std::vector<uint8_t> consts;
+  std::map<std::pair<std::string, uint32_t>, uint32_t> const_index;
+  uint32_t vars_end = 0;
+  uint32_t temp_top = 0, temp_max = 0;
+  // The last instruction that only defined a temporary, so a following store can
+  // retarget it to the variable instead of copying (x := a + b is one ADD).
+  uint32_t last_def_pos = UINT32_MAX;
+  Slot last_def;
+  uint32_t last_label_pos = 0;
+  uint32_t last_instr = UINT32_MAX;
+  std::unordered_map<std::string, Symbol*> locals;  // canon name -> symbol (frame or This)
+  bool is_method = false;
+  const Type* this_type = nullptr;  // FB type whose members are reachable (body or method)
+  struct Loop {
+    Label exit, cont;
+  };
+  std::vector<Loop> loops;
+  std::vector<std::unique_ptr<Symbol>> owned;  // This-symbols made for methods
+};
+
+class Compiler {
+ public:
+  Compiler(const SourceManager& sm, DiagEngine& diags, const CompileOptions& opt);
+  std::unique_ptr<Application> run(const std::vector<const CompilationUnit*>& units,
+                                   const std::vector<const TestFile*>& tests);
+
+  // ---- declarations (decls.cpp)
+  void index_unit(const CompilationUnit& u, bool stdlib);
+  void index_pou(const Pou& p, uint32_t file, bool stdlib, PouInfo* owner);
+  const Type* resolve_type(const TypeSpec& spec, uint32_t file, const std::string& name_hint = "");
+  const Type* named_type(const Ident& name, uint32_t file, bool report = true);
+  void layout_struct(Type* t, const std::vector<VarDecl>& members, uint32_t file);
+  void declare_vars(PouInfo* p);
+  void declare_globals(const std::vector<VarBlock>& blocks, const std::string& scope, uint32_t file);
+  std::optional<ConstV> const_eval(const Expr& e, uint32_t file, bool report = true);
+  std::optional<int64_t> const_int(const Expr& e, uint32_t file);
+  void write_init(std::vector<uint8_t>& image, uint32_t offset, const Type* t, const Expr* init, uint32_t file);
+  bool write_const(uint8_t* dst, const Type* t, const ConstV& c, SourceLoc loc);
+  bool locate(const DirectAddrExpr& a, const Type* t, uint32_t* addr, uint8_t* bit, bool* is_bit);
+  uint32_t alloc(uint32_t size, uint32_t align);
+  void ensure_compiled(PouInfo* p, SourceLoc use);
+  void declare_pou(PouInfo* p);
+  void ensure_layout(PouInfo* p, SourceLoc use);
+  bool implements(const PouInfo* fb, const PouInfo* itf) const;
+  uint32_t selector(const std::string& method_canon);
+
+  // ---- bodies (compiler.cpp)
+  void compile_pou(PouInfo* p);
+  void compile_test(const TestFile& tf, const TestCase& tc);
+  void finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries);
+  void emit(Op op, std::initializer_list<Arg> args);
+  void emit_list(Op op, const std::vector<Arg>& args);
+  void def(Slot dst);  // records that the instruction just emitted only wrote dst
+  bool retarget(Slot from, Slot to);
+  Val expr_for(const Expr& e, const Type* target);
+  Label new_label();
+  void bind(Label l);
+  void mark(SourceLoc loc);
+  Slot temp(uint32_t size, uint32_t align = 8);
+  Slot temp_for(const Type* t) { return temp(t->size ? t->size : 1, t->align < 8 ? t->align : 8); }
+  Slot konst(const Type* t, const ConstV& c, SourceLoc loc);
+  Slot konst_bytes(const void* data, uint32_t size, uint32_t align);
+  Slot konst_i64(int64_t v);
+  Slot konst_u32(uint32_t v);
+
+  // ---- statements (stmt.cpp)
+  void stmts(const StmtList& list);
+  void stmt(const Stmt& s);
+  void assign_stmt(const AssignStmt& s);
+  void if_stmt(const IfStmt& s);
+  void case_stmt(const CaseStmt& s);
+  void for_stmt(const ForStmt& s);
+  void while_stmt(const WhileStmt& s);
+  void repeat_stmt(const RepeatStmt& s);
+  uint32_t branch(SourceLoc loc, const char* kind);
+
+  // ---- expressions (expr.cpp)
+  Val expr(const Expr& e, const Type* expected = nullptr);
+  Val binary(const BinaryExpr& e, const Type* expected);
+  Val unary(const UnaryExpr& e, const Type* expected);
+  Val literal(const LiteralExpr& e, const Type* expected);
+  Place place(const Expr& e, bool for_write);
+  Place frame_place(Slot s, const Type* t) {
+    Place p;
+    p.k = Place::K::Frame;
+    p.type = t;
+    p.off = s.off;
+    p.sk = s.kind;
+    return p;
+  }
+  Place this_place(SourceLoc loc);
+  Place symbol_place(const Symbol* s, SourceLoc loc);
+  Place member_place(Place base, const Ident& member, SourceLoc loc);
+  Place index_place(Place base, const IndexExpr& e);
+  Place deref_place(Val ptr, const Type* target, SourceLoc loc);
+  Val load(const Place& p);
+  void store(const Place& p, Slot src);
+  void assign(const Place& dst, const Val& v, SourceLoc loc);
+  Val coerce(const Val& v, const Type* to, SourceLoc loc, const char* what);
+  Slot to_slot(const Val& v, const Type* t, SourceLoc loc);
+  Slot convert(Slot s, const Type* from, const Type* to);
+  Slot addr_of(const Place& p, SourceLoc loc);
+  Val cond(const Expr& e);
+  const Symbol* lookup(const std::string& canon_name) const;
+  Val bad() {
+    Val v;
+    v.ok = false;
+    return v;
+  }
+  const Type* default_type(const ConstV& c) const;
+  const Type* elem(TypeKind k) const { return tt_->elementary(k); }
+
+  // ---- calls (calls.cpp)
+  Val call(const CallExpr& c, bool as_statement);
+  Val call_function(PouInfo* f, const CallExpr& c);
+  Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
+  Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
+  std::optional<Val> builtin(const std::string& name, const CallExpr& c);
+  std::optional<Val> conversion(const std::string& name, const CallExpr& c);
+  Val property_get(const Place& inst, PouInfo* getter, Slot this_ptr, SourceLoc loc);
+  void property_set(PouInfo* setter, Slot this_ptr, const Val& v, SourceLoc loc);
+  std::vector<const Expr*> positional(const CallExpr& c, size_t min, size_t max, const char* name);
+  Val native(Native n, const Type* result, std::initializer_list<Slot> args, uint32_t cap = 0);
+
+  // ---- state
+  const SourceManager& sm_;
+  DiagEngine& diags_;
+  CompileOptions opt_;
+  std::unique_ptr<Application> app_;
+  TypeTable* tt_ = nullptr;
+  uint32_t file_ = 0;  // file of the body being compiled (for diagnostics)
+
+  struct TypeEntry {
+    const TypeDecl* decl = nullptr;
+    uint32_t file = 0;
+    const Type* type = nullptr;
+    bool resolving = false;
+  };
+  std::unordered_map<std::string, TypeEntry> types_;
+  std::unordered_map<std::string, PouInfo*> pous_;
+  std::unordered_map<std::string, Symbol*> globals_;
+  std::unordered_map<std::string, std::vector<const Type*>> enum_values_;
+  std::unordered_map<std::string, uint32_t> selectors_;
+  std::vector<PouInfo*> all_methods_;
+  std::vector<std::pair<uint32_t, PouInfo*>> entry_fix_;  // absolute code index -> POU entry
+  std::unordered_map<std::string, std::unique_ptr<Symbol>> enum_syms_;
+  const Type* null_type_ = nullptr;
+  std::vector<std::unique_ptr<Body>> bodies_;  // finished bodies waiting for final layout
+  std::vector<std::pair<Body*, std::vector<uint32_t>*>> pending_;
+  Body* b_ = nullptr;  // body being compiled
+  std::vector<PouInfo*> compiling_;
+  std::vector<std::unique_ptr<std::vector<uint32_t>>> entry_lists_;
+  std::vector<std::unique_ptr<PouInfo>> test_pous_;
+  std::vector<std::unique_ptr<Pou>> synthetic_;
+  uint32_t next_type_id_ = 1;
+};
+
+std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r, std::string* err);
+
+// Opcode families are laid out per storage type (see opcodes.def); these pick the member.
+uint32_t storage_index(Storage s);  // I8..F64 -> 0..9
+Op num_op(Op i8_variant, Storage s);
+Op int_op(Op i8_variant, Storage s);
+Op cvt_op(Storage from, Storage to);
+Op mov_op(uint32_t size);  // 1, 2, 4, 8; else MOVN
+ValueKind value_kind(const Type* t);
+
+}  // namespace plcfi::st::detail

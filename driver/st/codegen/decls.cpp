@@ -1,0 +1,883 @@
+// Declarations: the index of types and POUs, type resolution, memory layout of
+// structs, instances and frames, global variables, and constant evaluation.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <functional>
+
+#include "compiler_impl.hpp"
+
+namespace plcfi::st::detail {
+
+namespace {
+uint32_t align_up(uint32_t v, uint32_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
+
+template <class T>
+void put(uint8_t* p, T v) {
+  std::memcpy(p, &v, sizeof(T));
+}
+}  // namespace
+
+uint32_t Compiler::alloc(uint32_t size, uint32_t align) {
+  auto& img = app_->init_image;
+  uint32_t addr = align_up(static_cast<uint32_t>(img.size()), align < 1 ? 1 : align);
+  img.resize(addr + size, 0);
+  return addr;
+}
+
+uint32_t Compiler::selector(const std::string& method_canon) {
+  auto it = selectors_.find(method_canon);
+  if (it != selectors_.end()) return it->second;
+  uint32_t id = static_cast<uint32_t>(selectors_.size());
+  selectors_[method_canon] = id;
+  return id;
+}
+
+// ------------------------------------------------------------------ index
+
+void Compiler::index_unit(const CompilationUnit& u, bool stdlib) {
+  for (const auto& td : u.types) {
+    std::string key = canon(td.name.text);
+    if (types_.count(key) || tt_->by_name(key)) {
+      diags_.error("ST202", td.name.loc, "type '" + td.name.text + "' is declared twice");
+      continue;
+    }
+    types_[key] = TypeEntry{&td, u.file, nullptr, false};
+  }
+  for (const auto& p : u.pous) index_pou(*p, u.file, stdlib, nullptr);
+}
+
+void Compiler::index_pou(const Pou& p, uint32_t file, bool stdlib, PouInfo* owner) {
+  auto info = std::make_unique<PouInfo>();
+  PouInfo* pi = info.get();
+  pi->kind = p.kind;
+  pi->name = p.name.text;
+  pi->decl = &p;
+  pi->file = file;
+  pi->is_stdlib = stdlib;
+  pi->owner = owner;
+  for (const auto& blk : p.var_blocks) pi->blocks.push_back(&blk);
+  if (p.kind == PouKind::Program || p.kind == PouKind::FunctionBlock) {
+    pi->type = tt_->make(TypeKind::Pou, p.name.text);
+    pi->type->pou = pi;
+    pi->type->align = 8;
+    pi->type_id = next_type_id_++;
+  } else if (p.kind == PouKind::Interface) {
+    pi->type = tt_->make(TypeKind::Interface, p.name.text);
+    pi->type->pou = pi;
+    pi->type->size = 4;
+    pi->type->align = 4;
+    pi->type->init.assign(4, 0);
+  }
+  if (owner) {
+    for (const auto& m : owner->methods)
+      if (iequals(m->name, pi->name)) diags_.error("ST202", p.name.loc, "method '" + pi->name + "' is declared twice in '" + owner->name + "'");
+    owner->methods.push_back(std::move(info));
+    pi->selector = selector(canon(pi->name));
+    all_methods_.push_back(pi);
+  } else {
+    std::string key = canon(p.name.text);
+    if (pous_.count(key) || types_.count(key)) {
+      diags_.error("ST202", p.name.loc, "'" + p.name.text + "' is declared twice");
+    } else {
+      pous_[key] = pi;
+    }
+    app_->pous.push_back(std::move(info));
+  }
+  for (const auto& m : p.methods) index_pou(*m, file, stdlib, pi);
+  for (const auto& prop : p.properties) {
+    for (int k = 0; k < 2; ++k) {
+      const PouPtr& acc = k == 0 ? prop->getter : prop->setter;
+      if (!acc) continue;
+      auto a = std::make_unique<PouInfo>();
+      a->kind = PouKind::Method;
+      a->name = std::string(k == 0 ? "__GET_" : "__SET_") + canon(prop->name.text);
+      a->decl = acc.get();
+      a->file = file;
+      a->is_stdlib = stdlib;
+      a->owner = pi;
+      for (const auto& blk : acc->var_blocks) a->blocks.push_back(&blk);
+      a->property = prop.get();
+      a->is_setter = k == 1;
+      a->selector = selector(a->name);
+      all_methods_.push_back(a.get());
+      pi->methods.push_back(std::move(a));
+    }
+  }
+}
+
+// ------------------------------------------------------------------ types
+
+const Type* Compiler::named_type(const Ident& name, uint32_t file, bool report) {
+  if (const Type* t = tt_->by_name(name.text)) return t;
+  std::string key = canon(name.text);
+  auto it = types_.find(key);
+  if (it != types_.end()) {
+    TypeEntry& te = it->second;
+    if (te.type) return te.type;
+    if (te.resolving) {
+      diags_.error("ST201", name.loc, "type '" + name.text + "' is defined in terms of itself");
+      return nullptr;
+    }
+    te.resolving = true;
+    const Type* t = resolve_type(*te.decl->spec, te.file, te.decl->name.text);
+    if (t && te.decl->init) {
+      // TYPE T : INT := 5; END_TYPE -> a copy of the type with its own default.
+      Type* c = tt_->make(t->kind, te.decl->name.text);
+      *c = *t;
+      c->name = te.decl->name.text;
+      c->init.assign(c->size, 0);
+      std::copy(t->init.begin(), t->init.end(), c->init.begin());
+      write_init(c->init, 0, t, te.decl->init.get(), te.file);
+      t = c;
+    }
+    te.type = t;
+    te.resolving = false;
+    return t;
+  }
+  auto pit = pous_.find(key);
+  if (pit != pous_.end()) {
+    PouInfo* p = pit->second;
+    if (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) {
+      ensure_compiled(p, name.loc);
+      return p->type;
+    }
+    if (p->kind == PouKind::Interface) return p->type;
+    if (report) diags_.error("ST201", name.loc, "'" + name.text + "' is a function, not a type");
+    return nullptr;
+  }
+  if (report) diags_.error("ST201", name.loc, "unknown type '" + name.text + "'");
+  return nullptr;
+}
+
+const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const std::string& name_hint) {
+  uint32_t saved = file_;
+  file_ = file;
+  const Type* result = nullptr;
+  switch (spec.kind) {
+    case TypeSpecKind::Named: {
+      std::string c = canon(spec.name.text);
+      if ((c == "STRING" || c == "WSTRING") && spec.string_length) {
+        auto n = const_int(*spec.string_length, file);
+        if (!n) break;
+        if (*n < 1 || *n > 65535) {
+          diags_.error("ST238", spec.string_length->loc, "string length must be 1..65535, not " + std::to_string(*n));
+          break;
+        }
+        result = tt_->string_type(static_cast<uint32_t>(*n), c == "WSTRING");
+        break;
+      }
+      result = named_type(spec.name, file);
+      break;
+    }
+    case TypeSpecKind::Array: {
+      if (!spec.element) break;
+      const Type* el = resolve_type(*spec.element, file);
+      if (!el) break;
+      std::vector<Type::Dim> dims;
+      uint64_t count = 1;
+      bool ok = true;
+      for (const auto& r : spec.dims) {
+        auto lo = r.lo ? const_int(*r.lo, file) : std::nullopt;
+        auto hi = r.hi ? const_int(*r.hi, file) : std::nullopt;
+        if (!lo || !hi) {
+          ok = false;
+          break;
+        }
+        if (*hi < *lo || *lo < INT32_MIN || *hi > INT32_MAX) {
+          diags_.error("ST229", r.lo->loc, "invalid array bounds " + std::to_string(*lo) + ".." + std::to_string(*hi));
+          ok = false;
+          break;
+        }
+        dims.push_back({*lo, *hi});
+        count *= static_cast<uint64_t>(*hi - *lo + 1);
+      }
+      if (!ok) break;
+      if (count * el->size > (64u << 20)) {
+        diags_.error("ST229", spec.loc, "array of " + std::to_string(count) + " elements is too large");
+        break;
+      }
+      std::string nm = "ARRAY [";
+      for (size_t i = 0; i < dims.size(); ++i)
+        nm += (i ? ", " : "") + std::to_string(dims[i].lo) + ".." + std::to_string(dims[i].hi);
+      nm += "] OF " + el->name;
+      Type* t = tt_->make(TypeKind::Array, name_hint.empty() ? nm : name_hint);
+      t->elem = el;
+      t->dims = dims;
+      t->align = el->align;
+      t->size = static_cast<uint32_t>(count) * el->size;
+      t->init.resize(t->size);
+      for (uint64_t i = 0; i < count; ++i)
+        std::copy(el->init.begin(), el->init.end(), t->init.begin() + static_cast<long>(i * el->size));
+      result = t;
+      break;
+    }
+    case TypeSpecKind::Struct: {
+      Type* t = tt_->make(TypeKind::Struct, name_hint.empty() ? "STRUCT" : name_hint);
+      // Registered before its members so a member REF_TO the struct itself resolves.
+      if (!name_hint.empty()) {
+        auto it = types_.find(canon(name_hint));
+        if (it != types_.end() && !it->second.type) it->second.type = t;
+      }
+      layout_struct(t, spec.members, file);
+      result = t;
+      break;
+    }
+    case TypeSpecKind::Enum: {
+      const Type* base = spec.element ? resolve_type(*spec.element, file) : elem(TypeKind::Int);
+      if (!base) break;
+      if (!base->is_integer() && !base->is_bitstring()) {
+        diags_.error("ST201", spec.loc, "the base type of an enumeration must be an integer type, not " + base->name);
+        break;
+      }
+      Type* t = tt_->make(TypeKind::Enum, name_hint.empty() ? "<enum>" : name_hint);
+      t->base = base;
+      t->size = base->size;
+      t->align = base->align;
+      int64_t next = 0;
+      for (const auto& v : spec.enum_values) {
+        if (v.value) {
+          auto x = const_int(*v.value, file);
+          if (x) next = *x;
+        }
+        for (const auto& [n, _] : t->enum_values)
+          if (iequals(n, v.name.text)) diags_.error("ST202", v.name.loc, "enumeration value '" + v.name.text + "' is declared twice");
+        t->enum_values.emplace_back(v.name.text, next);
+        enum_values_[canon(v.name.text)].push_back(t);
+        ++next;
+      }
+      t->init.assign(t->size, 0);
+      if (!t->enum_values.empty()) write_const(t->init.data(), base, ConstV{ConstV::K::Int, t->enum_values[0].second, 0, {}}, spec.loc);
+      result = t;
+      break;
+    }
+    case TypeSpecKind::Subrange: {
+      const Type* base = spec.element ? resolve_type(*spec.element, file) : nullptr;
+      if (!base) break;
+      if (!base->is_integer()) {
+        diags_.error("ST229", spec.loc, "a subrange needs an integer base type, not " + base->name);
+        break;
+      }
+      auto lo = spec.sub_lo ? const_int(*spec.sub_lo, file) : std::nullopt;
+      auto hi = spec.sub_hi ? const_int(*spec.sub_hi, file) : std::nullopt;
+      if (!lo || !hi) break;
+      if (*hi < *lo) {
+        diags_.error("ST229", spec.loc, "empty subrange " + std::to_string(*lo) + ".." + std::to_string(*hi));
+        break;
+      }
+      Type* t = tt_->make(base->kind, name_hint.empty() ? base->name + " (" + std::to_string(*lo) + ".." + std::to_string(*hi) + ")" : name_hint);
+      t->size = base->size;
+      t->align = base->align;
+      t->ranged = true;
+      t->lo = *lo;
+      t->hi = *hi;
+      t->init.assign(t->size, 0);
+      if (*lo > 0 || *hi < 0) write_const(t->init.data(), base, ConstV{ConstV::K::Int, *lo, 0, {}}, spec.loc);
+      result = t;
+      break;
+    }
+    case TypeSpecKind::Ref: {
+      if (!spec.element) break;
+      // REF_TO a type being declared (linked lists): resolve lazily through the entry.
+      const Type* target = resolve_type(*spec.element, file);
+      if (target) result = tt_->ref_to(target);
+      break;
+    }
+  }
+  file_ = saved;
+  return result;
+}
+
+void Compiler::layout_struct(Type* t, const std::vector<VarDecl>& members, uint32_t file) {
+  uint32_t off = 0, align = 1;
+  struct Pending {
+    uint32_t offset;
+    const Type* type;
+    const Expr* init;
+  };
+  std::vector<Pending> inits;
+  for (const auto& d : members) {
+    const Type* ft = d.type ? resolve_type(*d.type, file) : nullptr;
+    if (!ft) continue;
+    for (const auto& n : d.names) {
+      if (t->field(n.text)) {
+        diags_.error("ST202", n.loc, "member '" + n.text + "' is declared twice");
+        continue;
+      }
+      off = align_up(off, ft->align);
+      t->fields.push_back(Field{n.text, ft, off, n.loc});
+      inits.push_back({off, ft, d.init.get()});
+      off += ft->size;
+      align = std::max(align, ft->align);
+    }
+  }
+  t->align = std::min<uint32_t>(align, 8);
+  t->size = align_up(off, t->align);
+  t->init.assign(t->size, 0);
+  for (const auto& p : inits) write_init(t->init, p.offset, p.type, p.init, file);
+}
+
+// ------------------------------------------------------------------ constants
+
+std::optional<int64_t> Compiler::const_int(const Expr& e, uint32_t file) {
+  auto c = const_eval(e, file);
+  if (!c) return std::nullopt;
+  if (c->k != ConstV::K::Int) {
+    diags_.error("ST215", e.loc, "an integer constant is required here");
+    return std::nullopt;
+  }
+  return c->i;
+}
+
+std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool report) {
+  auto fail = [&](const std::string& msg) -> std::optional<ConstV> {
+    if (report) diags_.error("ST215", e.loc, msg);
+    return std::nullopt;
+  };
+  switch (e.kind) {
+    case ExprKind::Literal: {
+      const auto& l = static_cast<const LiteralExpr&>(e);
+      ConstV c;
+      switch (l.lit) {
+        case LiteralKind::Int:
+          c.k = ConstV::K::Int;
+          c.i = static_cast<int64_t>(l.int_value);
+          if (!l.type_prefix.empty()) {
+            const Type* t = tt_->by_name(l.type_prefix);
+            if (t && t->is_real()) {
+              c.k = ConstV::K::Real;
+              c.r = static_cast<double>(l.int_value);
+            } else if (t && t->kind == TypeKind::Bool) {
+              c.k = ConstV::K::Bool;
+            }
+          }
+          return c;
+        case LiteralKind::Real: c.k = ConstV::K::Real; c.r = l.real_value; return c;
+        case LiteralKind::Bool: c.k = ConstV::K::Bool; c.i = l.int_value ? 1 : 0; return c;
+        case LiteralKind::String: case LiteralKind::WString: c.k = ConstV::K::Str; c.s = l.str_value; return c;
+        default: c.k = ConstV::K::Int; c.i = l.time_ns; return c;
+      }
+    }
+    case ExprKind::EnumLiteral: {
+      const auto& el = static_cast<const EnumLiteralExpr&>(e);
+      const Type* t = named_type(el.type_name, file, report);
+      if (!t) return std::nullopt;
+      if (t->kind == TypeKind::Enum) {
+        for (const auto& [n, v] : t->enum_values)
+          if (iequals(n, el.value.text)) return ConstV{ConstV::K::Int, v, 0, {}};
+        return fail("'" + el.value.text + "' is not a value of " + t->name);
+      }
+      return fail("'" + el.type_name.text + "' is not an enumeration");
+    }
+    case ExprKind::Name: {
+      const auto& n = static_cast<const NameExpr&>(e);
+      std::string key = canon(n.name.text);
+      const Symbol* s = lookup(key);
+      if (s && s->kind == SymKind::EnumValue) return ConstV{ConstV::K::Int, s->enum_value, 0, {}};
+      if (s && s->kind == SymKind::Var && s->constant && s->decl && s->decl->init) {
+        auto c = const_eval(*s->decl->init, file, report);
+        if (c && s->type && s->type->is_real() && c->k == ConstV::K::Int) {
+          c->k = ConstV::K::Real;
+          c->r = static_cast<double>(c->i);
+        }
+        return c;
+      }
+      if (!s) {
+        auto it = enum_values_.find(key);
+        if (it != enum_values_.end() && it->second.size() == 1) {
+          for (const auto& [vn, v] : it->second[0]->enum_values)
+            if (iequals(vn, n.name.text)) return ConstV{ConstV::K::Int, v, 0, {}};
+        }
+      }
+      return fail("'" + n.name.text + "' is not a constant");
+    }
+    case ExprKind::Unary: {
+      const auto& u = static_cast<const UnaryExpr&>(e);
+      auto c = const_eval(*u.operand, file, report);
+      if (!c) return std::nullopt;
+      if (u.op == UnaryOp::Plus) return c;
+      if (u.op == UnaryOp::Neg) {
+        if (c->k == ConstV::K::Int) c->i = static_cast<int64_t>(0ULL - static_cast<uint64_t>(c->i));
+        else if (c->k == ConstV::K::Real) c->r = -c->r;
+        else return fail("cannot negate this constant");
+        return c;
+      }
+      if (c->k == ConstV::K::Bool) c->i = !c->i;
+      else if (c->k == ConstV::K::Int) c->i = ~c->i;
+      else return fail("NOT needs a BOOL or bit-string constant");
+      return c;
+    }
+    case ExprKind::Binary: {
+      const auto& b = static_cast<const BinaryExpr&>(e);
+      auto l = const_eval(*b.lhs, file, report);
+      auto r = const_eval(*b.rhs, file, report);
+      if (!l || !r) return std::nullopt;
+      bool real = l->k == ConstV::K::Real || r->k == ConstV::K::Real;
+      if (real || b.op == BinaryOp::Pow) {
+        if (l->k == ConstV::K::Str || r->k == ConstV::K::Str) return fail("string constants cannot be combined");
+        double x = l->k == ConstV::K::Real ? l->r : static_cast<double>(l->i);
+        double y = r->k == ConstV::K::Real ? r->r : static_cast<double>(r->i);
+        ConstV c;
+        c.k = ConstV::K::Real;
+        switch (b.op) {
+          case BinaryOp::Add: c.r = x + y; return c;
+          case BinaryOp::Sub: c.r = x - y; return c;
+          case BinaryOp::Mul: c.r = x * y; return c;
+          case BinaryOp::Div: c.r = x / y; return c;
+          case BinaryOp::Pow: c.r = std::pow(x, y); return c;
+          default: break;
+        }
+        c.k = ConstV::K::Bool;
+        switch (b.op) {
+          case BinaryOp::Lt: c.i = x < y; return c;
+          case BinaryOp::Gt: c.i = x > y; return c;
+          case BinaryOp::Le: c.i = x <= y; return c;
+          case BinaryOp::Ge: c.i = x >= y; return c;
+          case BinaryOp::Eq: c.i = x == y; return c;
+          case BinaryOp::Ne: c.i = x != y; return c;
+          default: return fail("operator not applicable to REAL constants");
+        }
+      }
+      if (l->k == ConstV::K::Str || r->k == ConstV::K::Str) return fail("string constants cannot be combined");
+      int64_t x = l->i, y = r->i;
+      auto ux = static_cast<uint64_t>(x), uy = static_cast<uint64_t>(y);
+      ConstV c;
+      c.k = (l->k == ConstV::K::Bool && r->k == ConstV::K::Bool) ? ConstV::K::Bool : ConstV::K::Int;
+      switch (b.op) {
+        case BinaryOp::Add: c.i = static_cast<int64_t>(ux + uy); return c;
+        case BinaryOp::Sub: c.i = static_cast<int64_t>(ux - uy); return c;
+        case BinaryOp::Mul: c.i = static_cast<int64_t>(ux * uy); return c;
+        case BinaryOp::Div:
+        case BinaryOp::Mod:
+          if (y == 0) {
+            if (report) diags_.error("ST217", b.rhs->loc, "division by zero in a constant expression");
+            return std::nullopt;
+          }
+          if (y == -1) c.i = b.op == BinaryOp::Div ? static_cast<int64_t>(0ULL - ux) : 0;
+          else c.i = b.op == BinaryOp::Div ? x / y : x % y;
+          return c;
+        case BinaryOp::And: c.i = x & y; return c;
+        case BinaryOp::Or: c.i = x | y; return c;
+        case BinaryOp::Xor: c.i = x ^ y; return c;
+        default: break;
+      }
+      c.k = ConstV::K::Bool;
+      switch (b.op) {
+        case BinaryOp::Lt: c.i = x < y; return c;
+        case BinaryOp::Gt: c.i = x > y; return c;
+        case BinaryOp::Le: c.i = x <= y; return c;
+        case BinaryOp::Ge: c.i = x >= y; return c;
+        case BinaryOp::Eq: c.i = x == y; return c;
+        case BinaryOp::Ne: c.i = x != y; return c;
+        default: return fail("operator not applicable in a constant expression");
+      }
+    }
+    default: return fail("a constant expression is required here");
+  }
+}
+
+bool Compiler::write_const(uint8_t* dst, const Type* t, const ConstV& c, SourceLoc loc) {
+  auto range_error = [&](const std::string& v) {
+    diags_.error("ST216", loc, "constant " + v + " does not fit " + t->name);
+    return false;
+  };
+  if (t->kind == TypeKind::Enum) return write_const(dst, t->base, c, loc);
+  if (t->is_string()) {
+    if (c.k != ConstV::K::Str) {
+      diags_.error("ST203", loc, "a string is required for " + t->name);
+      return false;
+    }
+    size_t n = std::min<size_t>(c.s.size(), t->str_len);
+    std::memcpy(dst, c.s.data(), n);
+    dst[n] = 0;
+    return true;
+  }
+  if (t->kind == TypeKind::Bool) {
+    if (c.k == ConstV::K::Bool || (c.k == ConstV::K::Int && (c.i == 0 || c.i == 1))) {
+      dst[0] = c.i ? 1 : 0;
+      return true;
+    }
+    diags_.error("ST203", loc, "a BOOL value is required");
+    return false;
+  }
+  if (t->is_real()) {
+    double v = c.k == ConstV::K::Real ? c.r : static_cast<double>(c.i);
+    if (c.k != ConstV::K::Real && c.k != ConstV::K::Int) {
+      diags_.error("ST203", loc, "a number is required for " + t->name);
+      return false;
+    }
+    if (t->kind == TypeKind::Real) put<float>(dst, static_cast<float>(v));
+    else put<double>(dst, v);
+    return true;
+  }
+  if (t->kind == TypeKind::Ref || t->kind == TypeKind::Interface) {
+    put<uint32_t>(dst, 0);
+    return true;
+  }
+  if (c.k != ConstV::K::Int && !(c.k == ConstV::K::Bool && t->is_anybit())) {
+    diags_.error("ST203", loc, std::string("a ") + (t->is_time_like() ? "duration/date" : "integer") + " constant is required for " + t->name);
+    return false;
+  }
+  int64_t v = c.i;
+  switch (t->storage()) {
+    case Storage::I8: if (v < INT8_MIN || v > INT8_MAX) return range_error(std::to_string(v)); put<int8_t>(dst, static_cast<int8_t>(v)); break;
+    case Storage::I16: if (v < INT16_MIN || v > INT16_MAX) return range_error(std::to_string(v)); put<int16_t>(dst, static_cast<int16_t>(v)); break;
+    case Storage::I32: if (v < INT32_MIN || v > INT32_MAX) return range_error(std::to_string(v)); put<int32_t>(dst, static_cast<int32_t>(v)); break;
+    case Storage::I64: put<int64_t>(dst, v); break;
+    case Storage::U8: if (v < 0 || v > UINT8_MAX) return range_error(std::to_string(v)); put<uint8_t>(dst, static_cast<uint8_t>(v)); break;
+    case Storage::U16: if (v < 0 || v > UINT16_MAX) return range_error(std::to_string(v)); put<uint16_t>(dst, static_cast<uint16_t>(v)); break;
+    case Storage::U32: if (v < 0 || v > UINT32_MAX) return range_error(std::to_string(v)); put<uint32_t>(dst, static_cast<uint32_t>(v)); break;
+    case Storage::U64: put<uint64_t>(dst, static_cast<uint64_t>(v)); break;
+    default: return false;
+  }
+  if (t->ranged && (v < t->lo || v > t->hi))
+    return range_error(std::to_string(v) + " (subrange " + std::to_string(t->lo) + ".." + std::to_string(t->hi) + ")");
+  return true;
+}
+
+void Compiler::write_init(std::vector<uint8_t>& image, uint32_t offset, const Type* t, const Expr* init, uint32_t file) {
+  if (!t || offset + t->size > image.size()) return;
+  std::copy(t->init.begin(), t->init.end(), image.begin() + offset);
+  if (!init) return;
+  if (init->kind == ExprKind::ArrayInit) {
+    if (t->kind != TypeKind::Array) {
+      diags_.error("ST203", init->loc, "an array initializer needs an array, not " + t->name);
+      return;
+    }
+    const auto& ai = static_cast<const ArrayInitExpr&>(*init);
+    // Multi-dimensional arrays take a flat list (row-major) or nested lists per row.
+    uint64_t count = t->size / (t->elem->size ? t->elem->size : 1);
+    uint64_t idx = 0;
+    for (const auto& item : ai.items) {
+      int64_t rep = 1;
+      if (item.repeat) {
+        auto r = const_int(*item.repeat, file);
+        if (!r) return;
+        rep = *r;
+      }
+      for (int64_t k = 0; k < rep; ++k) {
+        if (idx >= count) {
+          diags_.error("ST209", init->loc, "too many initial values: " + t->name + " has " + std::to_string(count) + " elements");
+          return;
+        }
+        uint32_t eo = offset + static_cast<uint32_t>(idx * t->elem->size);
+        if (item.value && item.value->kind == ExprKind::ArrayInit && t->dims.size() > 1) {
+          // Nested row: fill the row's elements.
+          const auto& row = static_cast<const ArrayInitExpr&>(*item.value);
+          uint64_t row_len = static_cast<uint64_t>(t->dims.back().hi - t->dims.back().lo + 1);
+          uint64_t j = 0;
+          for (const auto& ri : row.items) {
+            int64_t rr = 1;
+            if (ri.repeat) {
+              auto r2 = const_int(*ri.repeat, file);
+              if (!r2) return;
+              rr = *r2;
+            }
+            for (int64_t q = 0; q < rr; ++q) {
+              if (j >= row_len || idx + j >= count) {
+                diags_.error("ST209", row.loc, "too many initial values in this row");
+                return;
+              }
+              write_init(image, offset + static_cast<uint32_t>((idx + j) * t->elem->size), t->elem, ri.value.get(), file);
+              ++j;
+            }
+          }
+          idx += row_len;
+          continue;
+        }
+        write_init(image, eo, t->elem, item.value.get(), file);
+        ++idx;
+      }
+    }
+    return;
+  }
+  if (init->kind == ExprKind::StructInit) {
+    if (t->kind != TypeKind::Struct && t->kind != TypeKind::Pou) {
+      diags_.error("ST203", init->loc, "a structure initializer needs a structure or FB instance, not " + t->name);
+      return;
+    }
+    for (const auto& item : static_cast<const StructInitExpr&>(*init).items) {
+      const Field* f = t->field(item.field.text);
+      if (!f) {
+        diags_.error("ST207", item.field.loc, "'" + t->name + "' has no member '" + item.field.text + "'");
+        continue;
+      }
+      write_init(image, offset + f->offset, f->type, item.value.get(), file);
+    }
+    return;
+  }
+  if (!t->is_elementary() && !t->is_string()) {
+    diags_.error("ST203", init->loc, "cannot initialize " + t->name + " with a single value");
+    return;
+  }
+  // Enumeration values by bare name resolve against the target enum first.
+  if (t->kind == TypeKind::Enum && init->kind == ExprKind::Name) {
+    const auto& n = static_cast<const NameExpr&>(*init);
+    for (const auto& [vn, v] : t->enum_values)
+      if (iequals(vn, n.name.text)) {
+        write_const(image.data() + offset, t->base, ConstV{ConstV::K::Int, v, 0, {}}, init->loc);
+        return;
+      }
+  }
+  auto c = const_eval(*init, file);
+  if (!c) return;
+  write_const(image.data() + offset, t, *c, init->loc);
+}
+
+// ------------------------------------------------------------------ addresses
+
+bool Compiler::locate(const DirectAddrExpr& a, const Type* t, uint32_t* addr, uint8_t* bit, bool* is_bit) {
+  const ImageArea* area = app_->image(a.area);
+  if (!area) {
+    diags_.error("ST218", a.loc, "unknown address area in " + a.text);
+    return false;
+  }
+  *is_bit = false;
+  *bit = 0;
+  uint32_t unit = 1;
+  switch (a.size) {
+    case 'X':
+      if (a.parts.size() != 2 || a.parts[1] > 7) {
+        diags_.error("ST218", a.loc, a.text + ": a bit address is byte.bit with bit 0..7");
+        return false;
+      }
+      *is_bit = true;
+      *bit = static_cast<uint8_t>(a.parts[1]);
+      unit = 1;
+      break;
+    case 'B': unit = 1; break;
+    case 'W': unit = 2; break;
+    case 'D': unit = 4; break;
+    case 'L': unit = 8; break;
+    default:
+      diags_.error("ST218", a.loc, "unknown size prefix in " + a.text);
+      return false;
+  }
+  if (!*is_bit && a.parts.size() != 1) {
+    diags_.error("ST218", a.loc, a.text + ": a byte/word address has a single number");
+    return false;
+  }
+  uint64_t byte = static_cast<uint64_t>(a.parts.empty() ? 0 : a.parts[0]) * unit;
+  if (byte + unit > area->size) {
+    diags_.error("ST218", a.loc, a.text + " is outside the %" + std::string(1, a.area) + " image (" + std::to_string(area->size) + " bytes)");
+    return false;
+  }
+  if (t) {
+    if (*is_bit && t->kind != TypeKind::Bool) {
+      diags_.error("ST218", a.loc, a.text + " is a bit address; it needs a BOOL variable, not " + t->name);
+      return false;
+    }
+    if (!*is_bit && t->size != unit) {
+      diags_.error("ST218", a.loc, a.text + " addresses " + std::to_string(unit * 8) + " bits; " + t->name + " has " + std::to_string(t->size * 8));
+      return false;
+    }
+  }
+  *addr = area->addr + static_cast<uint32_t>(byte);
+  return true;
+}
+
+// ------------------------------------------------------------------ variables
+
+void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::string& scope, uint32_t file) {
+  for (const auto& blk : blocks) {
+    for (const auto& d : blk.decls) {
+      const Type* t = d.type ? resolve_type(*d.type, file) : nullptr;
+      if (!t) continue;
+      for (const auto& n : d.names) {
+        std::string key = canon(n.text);
+        if (globals_.count(key)) {
+          diags_.error("ST202", n.loc, "global variable '" + n.text + "' is declared twice");
+          continue;
+        }
+        auto s = std::make_unique<Symbol>();
+        s->name = n.text;
+        s->type = t;
+        s->section = VarSection::Global;
+        s->constant = d.constant;
+        s->retain = d.retain;
+        s->decl = &d;
+        s->loc = n.loc;
+        if (d.location) {
+          bool is_bit = false;
+          if (!locate(*d.location, t, &s->offset, &s->bit, &is_bit)) continue;
+          s->where = is_bit ? Where::AbsBit : Where::Abs;
+          if (d.init) {
+            auto c = const_eval(*d.init, file);
+            if (c) {
+              if (is_bit) {
+                if (c->i) app_->init_image[s->offset] |= static_cast<uint8_t>(1u << s->bit);
+              } else {
+                write_const(app_->init_image.data() + s->offset, t, *c, d.init->loc);
+              }
+            }
+          }
+        } else {
+          s->where = Where::Abs;
+          s->offset = alloc(t->size, t->align);
+          write_init(app_->init_image, s->offset, t, d.init.get(), file);
+          if (d.retain) app_->retain_ranges.emplace_back(s->offset, t->size);
+        }
+        globals_[key] = s.get();
+        app_->globals.push_back(GlobalVar{scope, s.get()});
+        app_->global_syms.push_back(std::move(s));
+      }
+    }
+  }
+}
+
+// Creates the symbols of a POU's variables and lays out its instance or frame.
+void Compiler::declare_vars(PouInfo* p) {
+  uint32_t off = 8;
+  if (p->kind == PouKind::Method) off = 12;  // [8..12): THIS
+  if (p->base) off = align_up(p->base->frame_size, 8);
+  auto add = [&](const VarDecl& d, const Ident& n, const Type* t) -> Symbol* {
+    for (const auto& v : p->vars)
+      if (iequals(v->name, n.text)) {
+        diags_.error("ST202", n.loc, "'" + n.text + "' is declared twice in " + p->name);
+        return nullptr;
+      }
+    if (p->base && p->base->type && p->base->type->field(n.text)) {
+      diags_.error("ST202", n.loc, "'" + n.text + "' is already declared in the base FB " + p->base->name);
+      return nullptr;
+    }
+    auto s = std::make_unique<Symbol>();
+    s->name = n.text;
+    s->type = t;
+    s->section = d.section;
+    s->constant = d.constant;
+    s->retain = d.retain;
+    s->decl = &d;
+    s->loc = n.loc;
+    Symbol* raw = s.get();
+    p->vars.push_back(std::move(s));
+    return raw;
+  };
+  auto place_var = [&](Symbol* s, uint32_t size, uint32_t align) {
+    off = align_up(off, std::min<uint32_t>(align, 8));
+    s->where = Where::Frame;
+    s->offset = off;
+    off += size;
+  };
+  // Parameters first (their order is the calling convention), then result, then the rest.
+  static constexpr VarSection kOrder[] = {VarSection::Input, VarSection::InOut, VarSection::Output,
+                                          VarSection::Var,   VarSection::Stat,  VarSection::External,
+                                          VarSection::Global, VarSection::Config, VarSection::Temp};
+  bool is_callable = p->kind == PouKind::Function || p->kind == PouKind::Method;
+  for (VarSection sec : kOrder) {
+    if (is_callable && sec == VarSection::Output) {
+      // Result slot between in-outs and outputs: the part from here on is (re)initialized per call.
+      p->init_from = off;
+      const Type* rt = p->result;
+      if (rt && rt->kind != TypeKind::Void) {
+        off = align_up(off, std::min<uint32_t>(rt->align, 8));
+        p->result_offset = off;
+        off += rt->size;
+      }
+    }
+    if (!is_callable && sec == VarSection::Temp) p->init_from = align_up(off, 8);
+    for (const VarBlock* blkp : p->blocks) {
+      const VarBlock& blk = *blkp;
+      if (blk.section != sec) continue;
+      for (const auto& d : blk.decls) {
+        if (sec == VarSection::Global) {
+          diags_.error("ST235", d.loc, "VAR_GLOBAL belongs in a CONFIGURATION, RESOURCE or a global variable list, not in " + p->name);
+          continue;
+        }
+        if (sec == VarSection::Config) continue;
+        if (sec == VarSection::External) {
+          for (const auto& n : d.names) {
+            auto it = globals_.find(canon(n.text));
+            if (it == globals_.end()) {
+              diags_.error("ST228", n.loc, "VAR_EXTERNAL '" + n.text + "' has no matching VAR_GLOBAL");
+              continue;
+            }
+            const Type* t = d.type ? resolve_type(*d.type, p->file) : nullptr;
+            if (t && !same_type(t, it->second->type) && t != it->second->type) {
+              diags_.error("ST228", n.loc, "VAR_EXTERNAL '" + n.text + "' is declared " + t->name + " but the global is " + it->second->type->name);
+              continue;
+            }
+            Symbol* s = add(d, n, it->second->type);
+            if (!s) continue;
+            s->where = it->second->where;
+            s->offset = it->second->offset;
+            s->bit = it->second->bit;
+            s->constant = d.constant || it->second->constant;
+            if (!s->decl->init && it->second->decl) s->decl = it->second->decl;
+          }
+          continue;
+        }
+        const Type* t = d.type ? resolve_type(*d.type, p->file) : nullptr;
+        if (!t) continue;
+        if (t->kind == TypeKind::Pou && t->pou == p) {
+          diags_.error("ST240", d.loc, p->name + " cannot contain an instance of itself");
+          continue;
+        }
+        if (t->kind == TypeKind::Pou && is_callable && sec != VarSection::InOut) {
+          // FB instances inside functions would lose their state: IEC forbids it.
+          if (p->kind == PouKind::Function) {
+            diags_.error("ST239", d.loc, "a FUNCTION cannot declare function block instances (they would not keep their state)");
+            continue;
+          }
+        }
+        for (const auto& n : d.names) {
+          Symbol* s = add(d, n, t);
+          if (!s) continue;
+          if (d.location) {
+            bool is_bit = false;
+            if (!locate(*d.location, t, &s->offset, &s->bit, &is_bit)) continue;
+            s->where = is_bit ? Where::AbsBit : Where::Abs;
+            continue;
+          }
+          if (sec == VarSection::InOut) {
+            place_var(s, 4, 4);
+            s->where = Where::InOut;
+          } else {
+            place_var(s, t->size, t->align);
+          }
+          if (sec == VarSection::Input) p->inputs.push_back(s);
+          else if (sec == VarSection::Output) p->outputs.push_back(s);
+          else if (sec == VarSection::InOut) p->inouts.push_back(s);
+        }
+      }
+    }
+  }
+  p->frame_size = align_up(off, 8);
+  // FB and PROGRAM types expose their variables as fields (paths, member access).
+  if (p->type && p->kind != PouKind::Interface) {
+    Type* t = p->type;
+    if (p->base) t->fields = p->base->type->fields;
+    for (const auto& s : p->vars)
+      if (s->where == Where::Frame || s->where == Where::InOut)
+        t->fields.push_back(Field{s->name, s->where == Where::InOut ? tt_->ref_to(s->type) : s->type, s->offset, s->loc});
+  }
+}
+
+void Compiler::ensure_layout(PouInfo* p, SourceLoc use) { ensure_compiled(p, use); }
+
+void Compiler::ensure_compiled(PouInfo* p, SourceLoc use) {
+  if (p->compiled) return;
+  if (std::find(compiling_.begin(), compiling_.end(), p) != compiling_.end()) {
+    std::string chain;
+    for (auto* c : compiling_) chain += c->name + " -> ";
+    auto& d = diags_.error("ST214", use, "recursive use of '" + p->name + "' (" + chain + p->name +
+                                             "); IEC 61131-3 forbids recursion and instances containing themselves");
+    d.notes.emplace_back(p->decl->name.loc, "'" + p->name + "' is declared here");
+    return;
+  }
+  compile_pou(p);
+}
+
+bool Compiler::implements(const PouInfo* fb, const PouInfo* itf) const {
+  std::function<bool(const PouInfo*)> itf_matches = [&](const PouInfo* i) {
+    if (i == itf) return true;
+    for (const auto* e : i->interfaces)
+      if (itf_matches(e)) return true;
+    return false;
+  };
+  for (const PouInfo* f = fb; f; f = f->base)
+    for (const auto* i : f->interfaces)
+      if (itf_matches(i)) return true;
+  return fb == itf;
+}
+
+}  // namespace plcfi::st::detail

@@ -1,0 +1,425 @@
+// Statements: assignment, calls, IF, CASE, FOR, WHILE, REPEAT, EXIT, CONTINUE, RETURN,
+// and the test-file statements; every branch arm gets a coverage id.
+#include <algorithm>
+#include <set>
+
+#include "compiler_impl.hpp"
+
+namespace plcfi::st::detail {
+
+uint32_t Compiler::branch(SourceLoc loc, const char* kind) {
+  uint32_t id = static_cast<uint32_t>(app_->branches.size());
+  app_->branches.push_back(BranchPoint{loc, kind, b_ && b_->pou ? b_->pou->name : ""});
+  emit(Op::COV, {id});
+  return id;
+}
+
+void Compiler::stmts(const StmtList& list) {
+  bool dead = false;
+  for (const auto& s : list) {
+    if (dead && opt_.warnings && s->kind != StmtKind::Empty && !(b_->pou && b_->pou->is_stdlib)) {
+      diags_.warning("ST402", s->loc, "unreachable statement");
+      dead = false;  // once per list
+    }
+    stmt(*s);
+    if (s->kind == StmtKind::Return || s->kind == StmtKind::Exit || s->kind == StmtKind::Continue) dead = true;
+  }
+}
+
+void Compiler::stmt(const Stmt& s) {
+  uint32_t saved_top = b_->temp_top;
+  mark(s.loc);
+  switch (s.kind) {
+    case StmtKind::Assign: assign_stmt(static_cast<const AssignStmt&>(s)); break;
+    case StmtKind::Call: call(*static_cast<const CallStmt&>(s).call, true); break;
+    case StmtKind::If: if_stmt(static_cast<const IfStmt&>(s)); break;
+    case StmtKind::Case: case_stmt(static_cast<const CaseStmt&>(s)); break;
+    case StmtKind::For: for_stmt(static_cast<const ForStmt&>(s)); break;
+    case StmtKind::While: while_stmt(static_cast<const WhileStmt&>(s)); break;
+    case StmtKind::Repeat: repeat_stmt(static_cast<const RepeatStmt&>(s)); break;
+    case StmtKind::Exit:
+    case StmtKind::Continue:
+      if (b_->loops.empty()) {
+        diags_.error("ST219", s.loc, std::string(s.kind == StmtKind::Exit ? "EXIT" : "CONTINUE") + " outside a loop");
+        break;
+      }
+      emit(Op::JMP, {Arg::target(s.kind == StmtKind::Exit ? b_->loops.back().exit.id : b_->loops.back().cont.id)});
+      break;
+    case StmtKind::Return: emit(Op::RET, {}); break;
+    case StmtKind::Empty: break;
+    case StmtKind::Mock: {
+      const auto& m = static_cast<const MockStmt&>(s);
+      if (!opt_.test_mode) {
+        diags_.error("ST234", s.loc, "MOCK is only allowed in test files");
+        break;
+      }
+      Place p = place(*m.target, false);
+      if (!p.ok) break;
+      if (p.type->kind != TypeKind::Pou) {
+        diags_.error("ST234", m.target->loc, "MOCK needs a function block instance, not " + p.type->name);
+        break;
+      }
+      emit(Op::SETMOCK, {addr_of(p, s.loc)});
+      break;
+    }
+    case StmtKind::MockFunction: {
+      const auto& m = static_cast<const MockFunctionStmt&>(s);
+      if (!opt_.test_mode) {
+        diags_.error("ST234", s.loc, "MOCK_FUNCTION is only allowed in test files");
+        break;
+      }
+      auto it = pous_.find(canon(m.function.text));
+      if (it == pous_.end() || it->second->kind != PouKind::Function || it->second->is_stdlib) {
+        diags_.error("ST234", m.function.loc, "'" + m.function.text + "' is not a user FUNCTION");
+        break;
+      }
+      PouInfo* f = it->second;
+      ensure_compiled(f, s.loc);
+      if (!f->compiled || !f->mock_addr) break;
+      Val v = m.value ? expr(*m.value, f->result) : bad();
+      if (!v.ok) break;
+      if (f->result->kind == TypeKind::Void) {
+        diags_.error("ST234", s.loc, "'" + f->name + "' returns nothing");
+        break;
+      }
+      Val c = coerce(v, f->result, m.value->loc, "MOCK_FUNCTION");
+      if (!c.ok) break;
+      Slot val = to_slot(c, f->result, m.value->loc);
+      Place flag;
+      flag.k = Place::K::Abs;
+      flag.type = elem(TypeKind::Bool);
+      flag.off = f->mock_addr;
+      store(flag, konst(elem(TypeKind::Bool), ConstV{ConstV::K::Bool, 1, 0, {}}, s.loc));
+      Place value = flag;
+      value.type = f->result;
+      value.off = f->mock_addr + 8;
+      store(value, val);
+      break;
+    }
+  }
+  b_->temp_top = saved_top;
+}
+
+void Compiler::assign_stmt(const AssignStmt& s) {
+  // Warn about x := x, a typing accident more often than intent.
+  if (opt_.warnings && s.lhs->kind == ExprKind::Name && s.rhs->kind == ExprKind::Name &&
+      iequals(static_cast<const NameExpr&>(*s.lhs).name.text, static_cast<const NameExpr&>(*s.rhs).name.text))
+    diags_.warning("ST401", s.loc, "assignment of '" + static_cast<const NameExpr&>(*s.lhs).name.text + "' to itself");
+
+  // Property setters: obj.Prop := v, or Prop := v inside the FB.
+  if (s.lhs->kind == ExprKind::Member) {
+    const auto& m = static_cast<const MemberExpr&>(*s.lhs);
+    bool is_global = false;
+    if (m.base->kind == ExprKind::Name && !lookup(canon(static_cast<const NameExpr&>(*m.base).name.text))) is_global = true;
+    if (!is_global) {
+      // Evaluate the base place only when the member is not a plain field.
+      const Expr* base_e = m.base.get();
+      std::string setter = "__SET_" + canon(m.member.text);
+      const Symbol* bs = base_e->kind == ExprKind::Name ? lookup(canon(static_cast<const NameExpr&>(*base_e).name.text)) : nullptr;
+      if (bs && bs->type && bs->type->kind == TypeKind::Interface) {
+        if (PouInfo* st = bs->type->pou->find_method(setter)) {
+          Val itf = expr(*base_e);
+          Val v = expr_for(*s.rhs, st->inputs.empty() ? nullptr : st->inputs[0]->type);
+          property_set(st, itf.slot, v, s.loc);
+          return;
+        }
+      }
+      if (!bs || (bs->type && bs->type->kind == TypeKind::Pou && !bs->type->field(m.member.text)) || !bs) {
+        Place base = place(*base_e, true);
+        if (!base.ok) return;
+        if (base.type->kind == TypeKind::Pou && base.type->pou && !base.type->field(m.member.text)) {
+          if (PouInfo* st = base.type->pou->find_method(setter)) {
+            Val v = expr_for(*s.rhs, st->inputs.empty() ? nullptr : st->inputs[0]->type);
+            property_set(st, addr_of(base, s.loc), v, s.loc);
+            return;
+          }
+        }
+        if (base.type->kind == TypeKind::Interface && base.type->pou) {
+          if (PouInfo* st = base.type->pou->find_method(setter)) {
+            Val itf = load(base);
+            Val v = expr_for(*s.rhs, st->inputs.empty() ? nullptr : st->inputs[0]->type);
+            property_set(st, itf.slot, v, s.loc);
+            return;
+          }
+        }
+        Place dst = member_place(base, m.member, s.lhs->loc);
+        if (!dst.ok) return;
+        Val v = expr_for(*s.rhs, dst.type);
+        if (s.is_ref_assign) {
+          diags_.error("ST232", s.loc, "REF= needs a reference on the left");
+          return;
+        }
+        assign(dst, v, s.loc);
+        return;
+      }
+    }
+  }
+  if (s.lhs->kind == ExprKind::Name && b_->this_type && b_->this_type->pou) {
+    std::string key = canon(static_cast<const NameExpr&>(*s.lhs).name.text);
+    if (!lookup(key)) {
+      if (PouInfo* st = b_->this_type->pou->find_method("__SET_" + key)) {
+        Place self = this_place(s.loc);
+        Val v = expr_for(*s.rhs, st->inputs.empty() ? nullptr : st->inputs[0]->type);
+        property_set(st, addr_of(self, s.loc), v, s.loc);
+        return;
+      }
+    }
+  }
+  Place dst = place(*s.lhs, true);
+  if (!dst.ok) {
+    expr(*s.rhs);  // still check the right-hand side
+    return;
+  }
+  if (s.is_ref_assign) {
+    // r REF= x: r takes the address of x.
+    if (dst.type->kind != TypeKind::Ref) {
+      diags_.error("ST232", s.loc, "REF= needs a reference on the left, not " + dst.type->name);
+      return;
+    }
+    Place src = place(*s.rhs, false);
+    if (!src.ok) return;
+    if (!same_type(src.type, dst.type->target) && src.type != dst.type->target) {
+      diags_.error("ST203", s.rhs->loc, "REF= needs a " + dst.type->target->name + ", not " + src.type->name);
+      return;
+    }
+    Val v;
+    v.type = dst.type;
+    v.slot = addr_of(src, s.rhs->loc);
+    assign(dst, v, s.loc);
+    return;
+  }
+  Val v = expr_for(*s.rhs, dst.type);
+  if (v.ok && v.type && v.type->kind == TypeKind::Pou && dst.type->kind == TypeKind::Pou && v.type != dst.type) {
+    diags_.error("ST203", s.loc, "cannot assign an instance of " + v.type->name + " to " + dst.type->name);
+    return;
+  }
+  assign(dst, v, s.loc);
+}
+
+void Compiler::if_stmt(const IfStmt& s) {
+  Label end = new_label();
+  for (size_t i = 0; i < s.arms.size(); ++i) {
+    const auto& arm = s.arms[i];
+    uint32_t saved = b_->temp_top;
+    mark(arm.loc);
+    Val c = cond(*arm.cond);
+    if (opt_.warnings && c.ok && c.is_const && !(b_->pou && b_->pou->is_stdlib))
+      diags_.warning("ST404", arm.cond->loc, std::string("condition is always ") + (c.c.i ? "TRUE" : "FALSE"));
+    Label next = new_label();
+    if (c.ok) {
+      Slot cs = to_slot(c, elem(TypeKind::Bool), arm.cond->loc);
+      emit(Op::JMPF, {Arg::target(next.id), cs});
+    }
+    b_->temp_top = saved;
+    branch(arm.loc, i == 0 ? "IF" : "ELSIF");
+    stmts(arm.body);
+    if (i + 1 < s.arms.size() || s.else_body) emit(Op::JMP, {Arg::target(end.id)});
+    bind(next);
+  }
+  if (s.else_body) {
+    branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE");
+    stmts(*s.else_body);
+  }
+  bind(end);
+}
+
+void Compiler::case_stmt(const CaseStmt& s) {
+  Val sel = expr(*s.selector);
+  if (!sel.ok) return;
+  const Type* st = sel.type ? sel.type : default_type(sel.c);
+  if (!st->is_integer() && st->kind != TypeKind::Enum && !st->is_bitstring()) {
+    diags_.error("ST221", s.selector->loc, "CASE needs an integer or enumeration selector, not " + st->name);
+    return;
+  }
+  Slot sslot = to_slot(sel, st, s.selector->loc);
+  // Labels: constants checked for type and duplicates.
+  struct Range {
+    int64_t lo, hi;
+    size_t arm;
+  };
+  std::vector<Range> ranges;
+  auto label_value = [&](const Expr& e) -> std::optional<int64_t> {
+    Val v = expr(e, st);
+    if (!v.ok) return std::nullopt;
+    if (!v.is_const || v.c.k != ConstV::K::Int) {
+      diags_.error("ST221", e.loc, "a CASE label must be a constant");
+      return std::nullopt;
+    }
+    if (v.type && st->kind == TypeKind::Enum && v.type != st) {
+      diags_.error("ST221", e.loc, "label of type " + v.type->name + " in a CASE over " + st->name);
+      return std::nullopt;
+    }
+    if (!v.type && st->kind == TypeKind::Enum) {
+      diags_.error("ST221", e.loc, "use " + st->name + " values as labels, not integers");
+      return std::nullopt;
+    }
+    return v.c.i;
+  };
+  for (size_t a = 0; a < s.arms.size(); ++a) {
+    for (const auto& l : s.arms[a].labels) {
+      auto lo = l.lo ? label_value(*l.lo) : std::nullopt;
+      auto hi = l.hi ? label_value(*l.hi) : lo;
+      if (!lo || !hi) continue;
+      if (*hi < *lo) {
+        diags_.error("ST221", l.lo->loc, "empty label range");
+        continue;
+      }
+      for (const auto& r : ranges)
+        if (!(*hi < r.lo || *lo > r.hi)) {
+          diags_.error("ST221", l.lo->loc, "CASE label " + std::to_string(std::max(*lo, r.lo)) + " appears twice");
+          break;
+        }
+      ranges.push_back({*lo, *hi, a});
+    }
+  }
+  std::vector<Label> arm_labels;
+  for (size_t a = 0; a < s.arms.size(); ++a) arm_labels.push_back(new_label());
+  Label else_label = new_label();
+  Label end = new_label();
+
+  int64_t mn = INT64_MAX, mx = INT64_MIN;
+  uint64_t covered = 0;
+  for (const auto& r : ranges) {
+    mn = std::min(mn, r.lo);
+    mx = std::max(mx, r.hi);
+    covered += static_cast<uint64_t>(r.hi - r.lo + 1);
+  }
+  bool fits32 = st->size <= 4 && !(st->storage() == Storage::U32);
+  if (!ranges.empty() && fits32 && mx - mn < 1024 && covered * 3 >= static_cast<uint64_t>(mx - mn + 1)) {
+    // Dense labels: one jump table.
+    Slot idx = convert(sslot, st->kind == TypeKind::Enum ? st->base : st, elem(TypeKind::DInt));
+    std::vector<Arg> args{idx, static_cast<uint32_t>(static_cast<int32_t>(mn)), static_cast<uint32_t>(mx - mn + 1),
+                          Arg::target(else_label.id)};
+    for (int64_t v = mn; v <= mx; ++v) {
+      Label target = else_label;
+      for (const auto& r : ranges)
+        if (v >= r.lo && v <= r.hi) target = arm_labels[r.arm];
+      args.push_back(Arg::target(target.id));
+    }
+    emit_list(Op::JTAB, args);
+  } else {
+    const Type* ct = st->kind == TypeKind::Enum ? st->base : st;
+    for (const auto& r : ranges) {
+      Slot lo = konst(ct, ConstV{ConstV::K::Int, r.lo, 0, {}}, s.loc);
+      if (r.lo == r.hi) {
+        emit(num_op(Op::JEQ_I8, ct->storage()), {Arg::target(arm_labels[r.arm].id), sslot, lo});
+      } else {
+        Slot hi = konst(ct, ConstV{ConstV::K::Int, r.hi, 0, {}}, s.loc);
+        Label skip = new_label();
+        emit(num_op(Op::JLT_I8, ct->storage()), {Arg::target(skip.id), sslot, lo});
+        emit(num_op(Op::JGE_I8, ct->storage()), {Arg::target(arm_labels[r.arm].id), hi, sslot});
+        bind(skip);
+      }
+    }
+    emit(Op::JMP, {Arg::target(else_label.id)});
+  }
+  for (size_t a = 0; a < s.arms.size(); ++a) {
+    bind(arm_labels[a]);
+    branch(s.arms[a].loc, "CASE");
+    stmts(s.arms[a].body);
+    emit(Op::JMP, {Arg::target(end.id)});
+  }
+  bind(else_label);
+  if (s.else_body) {
+    branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE");
+    stmts(*s.else_body);
+  }
+  bind(end);
+}
+
+void Compiler::for_stmt(const ForStmt& s) {
+  Place var = place(*s.var, true);
+  if (!var.ok) return;
+  if (var.k != Place::K::Frame || !var.type->is_integer() || var.readonly) {
+    diags_.error("ST220", s.var->loc, "the FOR control variable must be a local variable of an integer type");
+    return;
+  }
+  const Type* t = var.type->ranged ? elem(var.type->kind) : var.type;
+  Val from = expr(*s.from, t);
+  Val to = expr(*s.to, t);
+  Val by = s.by ? expr(*s.by, t) : Val{nullptr, true, true, ConstV{ConstV::K::Int, 1, 0, {}}, {}};
+  if (!from.ok || !to.ok || !by.ok) return;
+  from = coerce(from, t, s.from->loc, "FOR");
+  to = coerce(to, t, s.to->loc, "FOR");
+  by = coerce(by, t, s.by ? s.by->loc : s.loc, "FOR");
+  if (!from.ok || !to.ok || !by.ok) return;
+  if (by.is_const && by.c.i == 0) {
+    diags_.error("ST220", s.by ? s.by->loc : s.loc, "FOR step must not be zero");
+    return;
+  }
+  // TO and BY are evaluated once, before the first iteration (IEC 61131-3).
+  Slot limit = to.is_const ? konst(t, to.c, s.loc) : temp_for(t);
+  if (!to.is_const) emit(mov_op(t->size), {limit, to.slot});
+  Slot step = by.is_const ? konst(t, by.c, s.loc) : temp_for(t);
+  if (!by.is_const) emit(mov_op(t->size), {step, by.slot});
+  assign(var, from, s.loc);
+  Slot iv{var.off, var.sk};
+  Label body = new_label(), cont = new_label(), exit = new_label();
+  bool down = by.is_const && by.c.i < 0;
+  Storage st = t->storage();
+  if (by.is_const) {
+    // Skip the loop when the range is empty.
+    if (down) emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), iv, limit});
+    else emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), limit, iv});
+    bind(body);
+    b_->loops.push_back({exit, cont});
+    branch(s.loc, "FOR");
+    stmts(s.body);
+    b_->loops.pop_back();
+    bind(cont);
+    emit(int_op(down ? Op::LOOPDN_I8 : Op::LOOPUP_I8, st), {iv, step, limit, Arg::target(body.id)});
+    bind(exit);
+    return;
+  }
+  // Step known only at run time: test its sign on each iteration.
+  Slot zero = konst(t, ConstV{ConstV::K::Int, 0, 0, {}}, s.loc);
+  Label up_test = new_label(), top = new_label();
+  bind(top);
+  emit(num_op(Op::JGE_I8, st), {Arg::target(up_test.id), step, zero});
+  emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), iv, limit});
+  emit(Op::JMP, {Arg::target(body.id)});
+  bind(up_test);
+  emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), limit, iv});
+  bind(body);
+  b_->loops.push_back({exit, cont});
+  branch(s.loc, "FOR");
+  stmts(s.body);
+  b_->loops.pop_back();
+  bind(cont);
+  emit(num_op(Op::ADD_I8, st), {iv, iv, step});
+  emit(Op::JMPB, {Arg::target(top.id)});
+  bind(exit);
+}
+
+void Compiler::while_stmt(const WhileStmt& s) {
+  Label top = new_label(), exit = new_label();
+  bind(top);
+  uint32_t saved = b_->temp_top;
+  Val c = cond(*s.cond);
+  if (c.ok) emit(Op::JMPF, {Arg::target(exit.id), to_slot(c, elem(TypeKind::Bool), s.cond->loc)});
+  b_->temp_top = saved;
+  b_->loops.push_back({exit, top});
+  branch(s.loc, "WHILE");
+  stmts(s.body);
+  b_->loops.pop_back();
+  emit(Op::JMPB, {Arg::target(top.id)});
+  bind(exit);
+}
+
+void Compiler::repeat_stmt(const RepeatStmt& s) {
+  Label top = new_label(), cont = new_label(), exit = new_label();
+  bind(top);
+  b_->loops.push_back({exit, cont});
+  branch(s.loc, "REPEAT");
+  stmts(s.body);
+  b_->loops.pop_back();
+  bind(cont);
+  if (s.until) {
+    Val c = cond(*s.until);
+    if (c.ok) emit(Op::JMPT, {Arg::target(exit.id), to_slot(c, elem(TypeKind::Bool), s.until->loc)});
+  }
+  emit(Op::JMPB, {Arg::target(top.id)});
+  bind(exit);
+}
+
+}  // namespace plcfi::st::detail

@@ -1,0 +1,163 @@
+// The standard function blocks of IEC 61131-3, written in ST and compiled with every
+// application. Timers read the scan clock through __NOW(), never the wall clock.
+#include "codegen/compiler.hpp"
+
+namespace plcfi::st {
+
+const char* stdlib_source() {
+  return R"ST(
+(* TON: Q rises when IN has been TRUE for PT; ET counts up to PT and resets with IN. *)
+FUNCTION_BLOCK TON
+VAR_INPUT IN : BOOL; PT : TIME; END_VAR
+VAR_OUTPUT Q : BOOL; ET : TIME; END_VAR
+VAR start : TIME; running : BOOL; END_VAR
+IF IN THEN
+  IF NOT running THEN
+    running := TRUE;
+    start := __NOW();
+  END_IF;
+  ET := __NOW() - start;
+  IF ET >= PT THEN
+    ET := PT;
+    Q := TRUE;
+  ELSE
+    Q := FALSE;
+  END_IF;
+ELSE
+  running := FALSE;
+  Q := FALSE;
+  ET := T#0s;
+END_IF;
+END_FUNCTION_BLOCK
+
+(* TOF: Q follows IN up at once and falls PT after IN falls. *)
+FUNCTION_BLOCK TOF
+VAR_INPUT IN : BOOL; PT : TIME; END_VAR
+VAR_OUTPUT Q : BOOL; ET : TIME; END_VAR
+VAR start : TIME; running : BOOL; END_VAR
+IF IN THEN
+  Q := TRUE;
+  ET := T#0s;
+  running := FALSE;
+ELSIF Q THEN
+  IF NOT running THEN
+    running := TRUE;
+    start := __NOW();
+  END_IF;
+  ET := __NOW() - start;
+  IF ET >= PT THEN
+    ET := PT;
+    Q := FALSE;
+    running := FALSE;
+  END_IF;
+END_IF;
+END_FUNCTION_BLOCK
+
+(* TP: a pulse of length PT on a rising edge of IN; not retriggerable while it runs. *)
+FUNCTION_BLOCK TP
+VAR_INPUT IN : BOOL; PT : TIME; END_VAR
+VAR_OUTPUT Q : BOOL; ET : TIME; END_VAR
+VAR start : TIME; running : BOOL; prev_in : BOOL; END_VAR
+IF running THEN
+  ET := __NOW() - start;
+  IF ET >= PT THEN
+    ET := PT;
+    Q := FALSE;
+    running := FALSE;
+  END_IF;
+ELSIF IN AND NOT prev_in THEN
+  start := __NOW();
+  ET := T#0s;
+  IF PT > T#0s THEN
+    running := TRUE;
+    Q := TRUE;
+  ELSE
+    Q := FALSE;
+  END_IF;
+ELSIF NOT IN THEN
+  ET := T#0s;
+END_IF;
+prev_in := IN;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK R_TRIG
+VAR_INPUT CLK : BOOL; END_VAR
+VAR_OUTPUT Q : BOOL; END_VAR
+VAR M : BOOL; END_VAR
+Q := CLK AND NOT M;
+M := CLK;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK F_TRIG
+VAR_INPUT CLK : BOOL; END_VAR
+VAR_OUTPUT Q : BOOL; END_VAR
+VAR M : BOOL; END_VAR
+Q := NOT CLK AND M;
+M := CLK;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK CTU
+VAR_INPUT CU : BOOL; R : BOOL; PV : INT; END_VAR
+VAR_OUTPUT Q : BOOL; CV : INT; END_VAR
+VAR prev : BOOL; END_VAR
+IF R THEN
+  CV := 0;
+ELSIF CU AND NOT prev AND CV < 32767 THEN
+  CV := CV + 1;
+END_IF;
+prev := CU;
+Q := CV >= PV;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK CTD
+VAR_INPUT CD : BOOL; LD : BOOL; PV : INT; END_VAR
+VAR_OUTPUT Q : BOOL; CV : INT; END_VAR
+VAR prev : BOOL; END_VAR
+IF LD THEN
+  CV := PV;
+ELSIF CD AND NOT prev AND CV > -32768 THEN
+  CV := CV - 1;
+END_IF;
+prev := CD;
+Q := CV <= 0;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK CTUD
+VAR_INPUT CU : BOOL; CD : BOOL; R : BOOL; LD : BOOL; PV : INT; END_VAR
+VAR_OUTPUT QU : BOOL; QD : BOOL; CV : INT; END_VAR
+VAR cu_prev : BOOL; cd_prev : BOOL; up : BOOL; down : BOOL; END_VAR
+up := CU AND NOT cu_prev;
+down := CD AND NOT cd_prev;
+IF R THEN
+  CV := 0;
+ELSIF LD THEN
+  CV := PV;
+ELSIF NOT (up AND down) THEN
+  IF up AND CV < 32767 THEN
+    CV := CV + 1;
+  ELSIF down AND CV > -32768 THEN
+    CV := CV - 1;
+  END_IF;
+END_IF;
+cu_prev := CU;
+cd_prev := CD;
+QU := CV >= PV;
+QD := CV <= 0;
+END_FUNCTION_BLOCK
+
+(* SR: set dominant. RS: reset dominant. *)
+FUNCTION_BLOCK SR
+VAR_INPUT S1 : BOOL; R : BOOL; END_VAR
+VAR_OUTPUT Q1 : BOOL; END_VAR
+Q1 := S1 OR (NOT R AND Q1);
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK RS
+VAR_INPUT S : BOOL; R1 : BOOL; END_VAR
+VAR_OUTPUT Q1 : BOOL; END_VAR
+Q1 := NOT R1 AND (S OR Q1);
+END_FUNCTION_BLOCK
+)ST";
+}
+
+}  // namespace plcfi::st

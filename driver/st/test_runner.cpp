@@ -1,0 +1,44 @@
+// ST unit-test execution.
+#include "test_runner.hpp"
+
+#include <chrono>
+
+namespace plcfi::st {
+
+std::vector<TestResult> run_tests(const Application& app, Machine& m, const TestRunOptions& opt) {
+  std::vector<TestResult> out;
+  m.set_budget(opt.budget);
+  for (const auto& t : app.tests) {
+    TestResult r;
+    r.file = t.loc.file < app.file_paths.size() ? app.file_paths[t.loc.file] : "";
+    r.name = t.name;
+    r.loc = t.loc;
+    auto start = std::chrono::steady_clock::now();
+    m.cold_restart();
+    m.set_now(0);
+    bool ok = true;
+    auto phase = [&](uint32_t entry, const char* what) {
+      if (!m.call(entry, t.instance_addr)) {
+        const Trap& tr = m.trap();
+        r.where = app.where(tr.loc);
+        r.message = tr.kind == TrapKind::AssertFailed ? tr.message : std::string(what) + ": " + describe_trap(app, tr);
+        return false;
+      }
+      return true;
+    };
+    if (t.has_setup) ok = phase(t.setup_entry, "in SETUP");
+    if (ok) ok = phase(t.body_entry, "runtime error");
+    if (t.has_teardown) {
+      bool td = phase(t.teardown_entry, "in TEARDOWN");
+      if (ok && !td) ok = false;
+    }
+    m.merge_coverage();
+    m.clear_taken();
+    r.passed = ok;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace plcfi::st

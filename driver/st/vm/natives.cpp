@@ -1,0 +1,245 @@
+// Native helpers for the standard functions that are not open-coded: transcendental
+// math, the string functions and conversions between values and text. All string
+// results are truncated to the destination's capacity and stay NUL-terminated.
+#include "natives.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "vm.hpp"
+
+namespace plcfi::st {
+
+namespace {
+template <class T>
+T ld(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+template <class T>
+void st(uint8_t* p, T v) {
+  std::memcpy(p, &v, sizeof(T));
+}
+const char* cs(const uint8_t* p) { return reinterpret_cast<const char*>(p); }
+char* cs(uint8_t* p) { return reinterpret_cast<char*>(p); }
+
+// Writes [s, s+n) as the string at dst with capacity cap. Source and destination may
+// overlap (s := LEFT(s, 2)), so build in a local buffer first when they do.
+void put(uint8_t* dst, uint32_t cap, const char* s, size_t n) {
+  if (n > cap) n = cap;
+  std::memmove(dst, s, n);
+  dst[n] = 0;
+}
+void put(uint8_t* dst, uint32_t cap, const std::string& s) { put(dst, cap, s.data(), s.size()); }
+
+int64_t clamp_len(int64_t v, size_t max) {
+  if (v < 0) return 0;
+  return static_cast<int64_t>(std::min<uint64_t>(static_cast<uint64_t>(v), max));
+}
+
+#define MATH(NAME, EXPR)                                                                    \
+  void NAME##_F32(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {       \
+    float x = ld<float>(b);                                                                 \
+    float y = ld<float>(c);                                                                 \
+    (void)y;                                                                                \
+    st<float>(a, static_cast<float>(EXPR));                                                 \
+  }                                                                                         \
+  void NAME##_F64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {       \
+    double x = ld<double>(b);                                                               \
+    double y = ld<double>(c);                                                               \
+    (void)y;                                                                                \
+    st<double>(a, static_cast<double>(EXPR));                                               \
+  }
+MATH(SQRT, std::sqrt(x))
+MATH(LN, std::log(x))
+MATH(LOG, std::log10(x))
+MATH(EXP, std::exp(x))
+MATH(SIN, std::sin(x))
+MATH(COS, std::cos(x))
+MATH(TAN, std::tan(x))
+MATH(ASIN, std::asin(x))
+MATH(ACOS, std::acos(x))
+MATH(ATAN, std::atan(x))
+MATH(EXPT, std::pow(x, y))
+#undef MATH
+
+// a: INT result, b: string
+void s_len(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  st<int16_t>(a, static_cast<int16_t>(std::strlen(cs(b))));
+}
+// a := LEFT(b, L = c)
+void s_left(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
+  std::string s = cs(b);
+  put(a, cap, s.substr(0, clamp_len(ld<int64_t>(c), s.size())));
+}
+void s_right(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
+  std::string s = cs(b);
+  auto n = clamp_len(ld<int64_t>(c), s.size());
+  put(a, cap, s.substr(s.size() - n));
+}
+// a := MID(b, L = c, P = d), P 1-based
+void s_mid(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  std::string s = cs(b);
+  int64_t p = ld<int64_t>(d);
+  if (p < 1 || static_cast<size_t>(p) > s.size()) return put(a, cap, "", 0);
+  put(a, cap, s.substr(p - 1, clamp_len(ld<int64_t>(c), s.size())));
+}
+void s_concat(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
+  put(a, cap, std::string(cs(b)) + cs(c));
+}
+// a := INSERT(IN1 = b, IN2 = c, P = d): IN2 inserted after the P-th character of IN1
+void s_insert(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  std::string s = cs(b);
+  auto p = clamp_len(ld<int64_t>(d), s.size());
+  s.insert(p, cs(c));
+  put(a, cap, s);
+}
+// a := DELETE(IN = b, L = c, P = d): L characters from position P
+void s_delete(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  std::string s = cs(b);
+  int64_t p = ld<int64_t>(d);
+  if (p >= 1 && static_cast<size_t>(p) <= s.size()) s.erase(p - 1, clamp_len(ld<int64_t>(c), s.size()));
+  put(a, cap, s);
+}
+// a := REPLACE(IN1 = b, IN2 = c, L = d[0], P = d[1])
+void s_replace(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  std::string s = cs(b);
+  int64_t l = ld<int64_t>(d), p = ld<int64_t>(d + 8);
+  if (p < 1) p = 1;
+  if (static_cast<size_t>(p) > s.size() + 1) p = static_cast<int64_t>(s.size()) + 1;
+  s.replace(p - 1, clamp_len(l, s.size()), cs(c));
+  put(a, cap, s);
+}
+// a: INT := FIND(IN1 = b, IN2 = c), 0 when not found
+void s_find(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
+  std::string s = cs(b);
+  std::string t = cs(c);
+  auto pos = t.empty() ? std::string::npos : s.find(t);
+  st<int16_t>(a, pos == std::string::npos ? int16_t(0) : static_cast<int16_t>(pos + 1));
+}
+
+void i64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(ld<int64_t>(b))); }
+void u64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(ld<uint64_t>(b))); }
+void f32_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", ld<float>(b))); }
+void f64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", ld<double>(b))); }
+void bool_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, *b ? "TRUE" : "FALSE"); }
+
+std::string duration_text(int64_t ns) {
+  std::string out = "T#";
+  if (ns < 0) {
+    out += '-';
+    ns = -ns;
+  }
+  if (ns == 0) return out + "0ms";
+  struct Unit {
+    int64_t ns;
+    const char* name;
+  };
+  static constexpr Unit kUnits[] = {{86'400'000'000'000, "d"}, {3'600'000'000'000, "h"}, {60'000'000'000, "m"},
+                                    {1'000'000'000, "s"},      {1'000'000, "ms"},          {1'000, "us"},
+                                    {1, "ns"}};
+  for (const auto& u : kUnits) {
+    if (ns >= u.ns) {
+      out += std::to_string(ns / u.ns) + u.name;
+      ns %= u.ns;
+    }
+  }
+  return out;
+}
+void civil(int64_t days, int* y, unsigned* m, unsigned* d) {  // days since 1970-01-01
+  days += 719468;
+  int64_t era = (days >= 0 ? days : days - 146096) / 146097;
+  unsigned doe = static_cast<unsigned>(days - era * 146097);
+  unsigned yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+  int64_t yy = static_cast<int64_t>(yoe) + era * 400;
+  unsigned doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+  unsigned mp = (5 * doy + 2) / 153;
+  *d = doy - (153 * mp + 2) / 5 + 1;
+  *m = mp < 10 ? mp + 3 : mp - 9;
+  *y = static_cast<int>(yy + (*m <= 2));
+}
+constexpr int64_t kDayNs = 86'400'000'000'000;
+int64_t floor_div(int64_t a, int64_t b) { return a / b - ((a % b != 0) && ((a < 0) != (b < 0))); }
+std::string date_part(int64_t ns) {
+  int y;
+  unsigned m, d;
+  civil(floor_div(ns, kDayNs), &y, &m, &d);
+  return fmt::format("{:04}-{:02}-{:02}", y, m, d);
+}
+std::string tod_part(int64_t ns) {
+  int64_t t = ns - floor_div(ns, kDayNs) * kDayNs;
+  int64_t ms = (t / 1'000'000) % 1000;
+  int64_t s = t / 1'000'000'000;
+  std::string out = fmt::format("{:02}:{:02}:{:02}", s / 3600, (s / 60) % 60, s % 60);
+  if (ms) out += fmt::format(".{:03}", ms);
+  return out;
+}
+void time_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, duration_text(ld<int64_t>(b))); }
+void date_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "D#" + date_part(ld<int64_t>(b))); }
+void tod_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "TOD#" + tod_part(ld<int64_t>(b))); }
+void dt_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  int64_t v = ld<int64_t>(b);
+  put(a, cap, "DT#" + date_part(v) + "-" + tod_part(v));
+}
+
+// Text to numbers: leading/trailing blanks allowed, garbage yields 0 (as PLC runtimes do).
+void s_to_i64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  st<int64_t>(a, std::strtoll(cs(b), nullptr, 10));
+}
+void s_to_u64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  st<uint64_t>(a, std::strtoull(cs(b), nullptr, 10));
+}
+void s_to_f64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  st<double>(a, std::strtod(cs(b), nullptr));
+}
+void s_to_bool(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  std::string s = cs(b);
+  for (char& ch : s) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  *a = s == "TRUE" || s == "1";
+}
+void s_to_time(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  // Accepts plain milliseconds ("1500") as CODESYS's STRING_TO_TIME does for bare numbers.
+  st<int64_t>(a, std::strtoll(cs(b), nullptr, 10) * 1'000'000);
+}
+void dt_to_date(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  st<int64_t>(a, floor_div(ld<int64_t>(b), kDayNs) * kDayNs);
+}
+void dt_to_tod(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  int64_t v = ld<int64_t>(b);
+  st<int64_t>(a, v - floor_div(v, kDayNs) * kDayNs);
+}
+
+struct Entry {
+  NativeFn fn;
+  const char* name;
+};
+constexpr Entry kNatives[] = {
+#define X(n) {n##_F32, #n "_F32"}, {n##_F64, #n "_F64"},
+    PLCFI_NATIVE_MATH(X)
+#undef X
+    {s_len, "LEN"}, {s_left, "LEFT"}, {s_right, "RIGHT"}, {s_mid, "MID"}, {s_concat, "CONCAT"},
+    {s_insert, "INSERT"}, {s_delete, "DELETE"}, {s_replace, "REPLACE"}, {s_find, "FIND"},
+    {i64_to_s, "I64_TO_STRING"}, {u64_to_s, "U64_TO_STRING"}, {f32_to_s, "REAL_TO_STRING"},
+    {f64_to_s, "LREAL_TO_STRING"}, {bool_to_s, "BOOL_TO_STRING"}, {time_to_s, "TIME_TO_STRING"},
+    {date_to_s, "DATE_TO_STRING"}, {tod_to_s, "TOD_TO_STRING"}, {dt_to_s, "DT_TO_STRING"},
+    {s_to_i64, "STRING_TO_I64"}, {s_to_u64, "STRING_TO_U64"}, {s_to_f64, "STRING_TO_LREAL"},
+    {s_to_bool, "STRING_TO_BOOL"}, {s_to_time, "STRING_TO_TIME"},
+    {dt_to_date, "DT_TO_DATE"}, {dt_to_tod, "DT_TO_TOD"},
+};
+static_assert(sizeof(kNatives) / sizeof(kNatives[0]) == static_cast<size_t>(Native::Count_));
+
+void bad_native(Machine&, uint32_t, uint8_t*, uint8_t*, uint8_t*, uint8_t*) {}
+}  // namespace
+
+NativeFn native(uint32_t id) {
+  return id < static_cast<uint32_t>(Native::Count_) ? kNatives[id].fn : bad_native;
+}
+const char* native_name(uint32_t id) {
+  return id < static_cast<uint32_t>(Native::Count_) ? kNatives[id].name : "?";
+}
+
+}  // namespace plcfi::st

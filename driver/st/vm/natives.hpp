@@ -1,0 +1,23 @@
+// Identifiers of the native helper functions called by the NATIVE instruction.
+#pragma once
+
+#include <cstdint>
+
+namespace plcfi::st {
+
+// Operand conventions (a, b, c, d are frame pointers; cap = result string capacity):
+//   math:   a := f(b) on F32 or F64 (EXPT: a := b ** c)
+//   string: see natives.cpp for each function's operands; integer operands are I64.
+enum class Native : uint32_t {
+#define PLCFI_NATIVE_MATH(X) X(SQRT) X(LN) X(LOG) X(EXP) X(SIN) X(COS) X(TAN) X(ASIN) X(ACOS) X(ATAN) X(EXPT)
+#define X(n) n##_F32, n##_F64,
+  PLCFI_NATIVE_MATH(X)
+#undef X
+  S_LEN, S_LEFT, S_RIGHT, S_MID, S_CONCAT, S_INSERT, S_DELETE, S_REPLACE, S_FIND,
+  I64_TO_S, U64_TO_S, F32_TO_S, F64_TO_S, BOOL_TO_S, TIME_TO_S, DATE_TO_S, TOD_TO_S, DT_TO_S,
+  S_TO_I64, S_TO_U64, S_TO_F64, S_TO_BOOL, S_TO_TIME,
+  DT_TO_DATE, DT_TO_TOD,
+  Count_
+};
+
+}  // namespace plcfi::st

@@ -1,0 +1,163 @@
+// The compiled application: bytecode, its line table, the cold-start memory image, the
+// layout of every POU and variable, tasks and program instances. Immutable after compile;
+// any number of Machines can run it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sema/types.hpp"
+#include "syntax/ast.hpp"
+
+namespace plcfi::st {
+
+enum class Op : uint32_t {
+#define OP(name, nargs, rtl) name,
+#include "opcodes.def"
+#undef OP
+  Count_
+};
+
+struct OpInfo {
+  const char* name;
+  uint8_t nargs;
+  const char* rtl;
+};
+const OpInfo& op_info(Op op);
+// Operand words that follow the opcode (JTAB adds its table).
+uint32_t op_length(const uint32_t* code);
+
+// Where a variable lives.
+enum class Where : uint8_t {
+  Frame,    // base-relative: POU instance vars, function/method frame vars
+  Abs,      // absolute: globals, located variables on byte/word addresses
+  AbsBit,   // absolute bit: located BOOL on %IX/%QX/%MX
+  InOut,    // base-relative slot holding the address (VAR_IN_OUT)
+  This,     // instance member seen from a method: THIS pointer slot + offset
+};
+
+enum class SymKind : uint8_t { Var, EnumValue, Pou, TypeName };
+
+struct Symbol {
+  std::string name;
+  SymKind kind = SymKind::Var;
+  const Type* type = nullptr;
+  Where where = Where::Frame;
+  uint32_t offset = 0;  // frame offset, absolute address, or field offset (This)
+  uint8_t bit = 0;      // AbsBit
+  VarSection section = VarSection::Var;
+  bool constant = false;
+  bool retain = false;
+  const VarDecl* decl = nullptr;
+  SourceLoc loc;
+  int64_t enum_value = 0;      // EnumValue
+  PouInfo* pou = nullptr;      // Pou
+  mutable uint32_t reads = 0;  // for "unused variable" warnings
+  mutable uint32_t writes = 0;
+};
+
+// Layout and code of one POU (FUNCTION, FUNCTION_BLOCK, PROGRAM, METHOD, INTERFACE).
+struct PouInfo {
+  PouKind kind = PouKind::Program;
+  std::string name;
+  const Pou* decl = nullptr;
+  uint32_t file = 0;
+  Type* type = nullptr;           // FB/PROGRAM/INTERFACE: instance type
+  const Type* result = nullptr;   // FUNCTION/METHOD: result type (Void when none)
+  PouInfo* base = nullptr;        // EXTENDS
+  PouInfo* owner = nullptr;       // METHOD: the FB or interface it belongs to
+  std::vector<PouInfo*> interfaces;
+  std::vector<std::unique_ptr<Symbol>> vars;   // declaration order; parameters first
+  std::vector<Symbol*> inputs, outputs, inouts;
+  std::vector<std::unique_ptr<PouInfo>> methods;
+  std::vector<const VarBlock*> blocks;          // declaration blocks (tests merge SETUP's)
+  const PropertyDecl* property = nullptr;       // getter/setter of this property
+  bool is_setter = false;
+  uint32_t type_id = 0;     // FB/PROGRAM: index into the dispatch table
+  uint32_t frame_size = 0;  // instance size (FB/PROGRAM) or frame size (FUNCTION/METHOD)
+  uint32_t result_offset = 0;
+  uint32_t init_from = 0, init_to = 0;  // FUNCTION/METHOD: frame part initialized on entry
+  uint32_t tmpl_from = 0, tmpl_to = 0;  // frame part (re)initialized per call, from a template
+  uint32_t template_addr = 0;           // absolute address of that template
+  uint32_t entry = 0;       // code index of the body
+  uint32_t selector = 0;    // METHOD: global selector for dynamic dispatch
+  uint32_t mock_addr = 0;   // FUNCTION in test builds: {flag, pad, value} block
+  bool declared = false;    // signature and variable layout done
+  bool compiled = false;
+  bool is_stdlib = false;
+  bool recursion_mark = false;
+
+  Symbol* find_var(std::string_view name) const;
+  PouInfo* find_method(std::string_view name) const;  // searches bases too
+};
+
+struct BranchPoint {
+  SourceLoc loc;
+  std::string kind;  // IF, ELSIF, ELSE, CASE, FOR, WHILE, REPEAT
+  std::string pou;
+};
+
+struct ProgramInstance {
+  std::string name;
+  PouInfo* pou = nullptr;
+  uint32_t addr = 0;
+  std::string task;  // empty without a configuration
+};
+
+struct TaskInfo {
+  std::string name;
+  int64_t interval_ns = 0;
+  int64_t priority = 0;
+  SourceLoc loc;
+  std::vector<size_t> programs;  // indices into Application::programs
+};
+
+struct TestEntry {
+  std::string name;
+  SourceLoc loc;
+  uint32_t instance_addr = 0;
+  uint32_t setup_entry = 0, body_entry = 0, teardown_entry = 0;
+  bool has_setup = false, has_teardown = false;
+};
+
+struct GlobalVar {
+  std::string scope;  // GVL file stem or configuration/resource name
+  Symbol* sym = nullptr;
+};
+
+struct ImageArea {
+  char area;
+  uint32_t addr;
+  uint32_t size;
+};
+
+class Application {
+ public:
+  std::vector<uint32_t> code;
+  std::vector<std::pair<uint32_t, SourceLoc>> lines;  // (first pc, location), sorted by pc
+  std::vector<uint8_t> init_image;                     // memory at cold start
+  std::vector<std::pair<uint32_t, uint32_t>> retain_ranges;  // (addr, size)
+  std::vector<BranchPoint> branches;                   // index = branch id
+  std::vector<uint32_t> vtable;                        // [selector * n_types + type_id] -> entry
+  uint32_t n_types = 0;
+  std::vector<ProgramInstance> programs;
+  std::vector<TaskInfo> tasks;
+  std::vector<TestEntry> tests;
+  std::vector<GlobalVar> globals;
+  std::vector<std::unique_ptr<Symbol>> global_syms;
+  std::vector<std::unique_ptr<PouInfo>> pous;
+  std::vector<std::string> file_paths;  // file index -> path
+  uint32_t mstack_addr = 0, mstack_size = 0;  // method frames (dynamic)
+  ImageArea image_i{'I', 0, 0}, image_q{'Q', 0, 0}, image_m{'M', 0, 0};
+  std::unique_ptr<TypeTable> types;
+  bool has_configuration = false;
+
+  SourceLoc loc_of(uint32_t pc) const;
+  std::string where(SourceLoc loc) const;  // "file:line:col"
+  PouInfo* find_pou(std::string_view name) const;
+  const ImageArea* image(char area) const;
+};
+
+}  // namespace plcfi::st

@@ -1,0 +1,671 @@
+// The VM's dispatch loop (computed goto over opcodes.def) and its trap handling.
+#include "vm.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+
+#include <fmt/format.h>
+
+namespace plcfi::st {
+
+namespace {
+constexpr OpInfo kOps[] = {
+#define OP(name, nargs, rtl) {#name, nargs, rtl},
+#include "opcodes.def"
+#undef OP
+};
+
+template <class T>
+inline T ld(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+template <class T>
+inline void st(uint8_t* p, T v) {
+  std::memcpy(p, &v, sizeof(T));
+}
+
+// Two's-complement wraparound without undefined behaviour (IEC integer overflow wraps).
+template <class T>
+using Wide = std::conditional_t<(sizeof(T) < 4), uint32_t, std::make_unsigned_t<T>>;
+template <class T>
+inline T wadd(T a, T b) {
+  if constexpr (std::is_floating_point_v<T>) return a + b;
+  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) +
+                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
+}
+template <class T>
+inline T wsub(T a, T b) {
+  if constexpr (std::is_floating_point_v<T>) return a - b;
+  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) -
+                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
+}
+template <class T>
+inline T wmul(T a, T b) {
+  if constexpr (std::is_floating_point_v<T>) return a * b;
+  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) *
+                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
+}
+template <class T>
+inline T wneg(T a) {
+  if constexpr (std::is_floating_point_v<T>) return -a;
+  else return wsub<T>(T(0), a);
+}
+template <class T>
+inline T wdiv(T a, T b) {  // b != 0 checked by the caller for integers
+  if constexpr (std::is_signed_v<T> && std::is_integral_v<T>) {
+    if (b == T(-1)) return wneg(a);
+  }
+  return static_cast<T>(a / b);
+}
+template <class T>
+inline T wmod(T a, T b) {
+  if constexpr (std::is_signed_v<T>) {
+    if (b == T(-1)) return T(0);
+  }
+  return static_cast<T>(a % b);
+}
+template <class T>
+inline T wabs(T a) {
+  if constexpr (std::is_floating_point_v<T>) return std::fabs(a);
+  else if constexpr (std::is_signed_v<T>) return a < 0 ? wneg(a) : a;
+  else return a;
+}
+// Conversions saturate where C++ would be undefined (float to integer out of range, NaN).
+template <class To, class From>
+inline To cvt(From v) {
+  if constexpr (std::is_integral_v<To> && std::is_floating_point_v<From>) {
+    if (std::isnan(v)) return To(0);
+    if (v <= static_cast<From>(std::numeric_limits<To>::min())) return std::numeric_limits<To>::min();
+    if (v >= static_cast<From>(std::numeric_limits<To>::max())) return std::numeric_limits<To>::max();
+    return static_cast<To>(v);
+  } else {
+    return static_cast<To>(v);
+  }
+}
+template <class T>
+inline T shl(T v, uint64_t n) {
+  using U = std::make_unsigned_t<T>;
+  if (n >= sizeof(T) * 8) return T(0);
+  return static_cast<T>(static_cast<U>(static_cast<Wide<T>>(static_cast<U>(v)) << n));
+}
+template <class T>
+inline T shr(T v, uint64_t n) {
+  using U = std::make_unsigned_t<T>;
+  if (n >= sizeof(T) * 8) return T(0);
+  return static_cast<T>(static_cast<U>(static_cast<U>(v) >> n));
+}
+template <class T>
+inline T rol(T v, uint64_t n) {
+  constexpr uint64_t w = sizeof(T) * 8;
+  n %= w;
+  if (n == 0) return v;
+  return static_cast<T>(shl(v, n) | shr(v, w - n));
+}
+template <class T>
+inline T ror(T v, uint64_t n) {
+  constexpr uint64_t w = sizeof(T) * 8;
+  n %= w;
+  if (n == 0) return v;
+  return static_cast<T>(shr(v, n) | shl(v, w - n));
+}
+}  // namespace
+
+const OpInfo& op_info(Op op) { return kOps[static_cast<uint32_t>(op)]; }
+
+uint32_t op_length(const uint32_t* code) {
+  Op op = static_cast<Op>(code[0]);
+  if (op == Op::JTAB) return 1 + 4 + code[3];
+  return 1 + kOps[code[0]].nargs;
+}
+
+const char* trap_name(TrapKind k) {
+  switch (k) {
+    case TrapKind::None: return "none";
+    case TrapKind::DivisionByZero: return "division by zero";
+    case TrapKind::IndexOutOfRange: return "array index out of range";
+    case TrapKind::RangeError: return "subrange violation";
+    case TrapKind::NullReference: return "null reference";
+    case TrapKind::Watchdog: return "watchdog: instruction budget exhausted";
+    case TrapKind::CallDepth: return "call depth exceeded";
+    case TrapKind::AssertFailed: return "assertion failed";
+    case TrapKind::NotImplemented: return "method not implemented";
+    case TrapKind::BadAddress: return "address outside memory";
+  }
+  return "?";
+}
+
+Machine::Machine(const Application& app) : app_(&app) {
+  mem_ = app.init_image;
+  size_t words = (app.branches.size() + 63) / 64;
+  taken_.assign(words, 0);
+  covered_.assign(words, 0);
+}
+
+void Machine::cold_restart() { std::memcpy(mem_.data(), app_->init_image.data(), mem_.size()); }
+
+void Machine::warm_restart() {
+  std::vector<uint8_t> keep;
+  for (auto [addr, size] : app_->retain_ranges) keep.insert(keep.end(), mem_.begin() + addr, mem_.begin() + addr + size);
+  cold_restart();
+  size_t pos = 0;
+  for (auto [addr, size] : app_->retain_ranges) {
+    std::memcpy(mem_.data() + addr, keep.data() + pos, size);
+    pos += size;
+  }
+}
+
+void Machine::clear_taken() { std::fill(taken_.begin(), taken_.end(), 0); }
+
+void Machine::merge_coverage() {
+  for (size_t i = 0; i < taken_.size(); ++i) covered_[i] |= taken_[i];
+}
+
+bool Machine::fail(TrapKind k, const uint32_t* pc, std::string msg) {
+  trap_.kind = k;
+  trap_.pc = static_cast<uint32_t>(pc - app_->code.data());
+  trap_.loc = app_->loc_of(trap_.pc);
+  trap_.message = std::move(msg);
+  return false;
+}
+
+bool Machine::call(uint32_t entry, uint32_t base_addr) {
+  trap_ = Trap{};
+  if (entry >= app_->code.size() || base_addr > mem_.size())
+    return fail(TrapKind::BadAddress, app_->code.data(), "entry or base outside the application");
+  return run(app_->code.data() + entry, mem_.data() + base_addr);
+}
+
+bool Machine::run(const uint32_t* pc, uint8_t* base) {
+  uint8_t* const mem = mem_.data();
+  const uint64_t msize = mem_.size();
+  const uint32_t* const code = app_->code.data();
+  const uint32_t* const vtable = app_->vtable.data();
+  const uint32_t n_types = app_->n_types;
+  uint64_t* const taken = taken_.data();
+  size_t sp = 0;
+  uint32_t mtop = app_->mstack_addr;
+  const uint32_t mend = app_->mstack_addr + app_->mstack_size;
+  int64_t budget = static_cast<int64_t>(budget_limit_);
+
+  static const void* const kLabels[] = {
+#define OP(name, nargs, rtl) &&L_##name,
+#include "opcodes.def"
+#undef OP
+  };
+
+#define DISPATCH() goto* kLabels[*pc]
+#define NEXT(n)  \
+  do {           \
+    pc += 1 + n; \
+    DISPATCH();  \
+  } while (0)
+#define R(T, i) ld<T>(base + pc[i])
+#define W(T, i, v) st<T>(base + pc[i], (v))
+  // Resolves the address held in slot i, checking null and bounds for n bytes.
+#define PTR(dst, i, disp, n)                                                                  \
+  uint64_t dst = static_cast<uint64_t>(ld<uint32_t>(base + pc[i])) + (disp);                  \
+  if (ld<uint32_t>(base + pc[i]) == 0) return fail(TrapKind::NullReference, pc, "dereference of a null reference"); \
+  if (dst + (n) > msize) return fail(TrapKind::BadAddress, pc, fmt::format("address {} outside memory", dst))
+#define BACKJUMP()                                                                              \
+  if (--budget < 0)                                                                             \
+    return fail(TrapKind::Watchdog, pc,                                                         \
+                fmt::format("more than {} loop iterations in one call (endless loop?)", budget_limit_))
+
+  DISPATCH();
+
+L_NOP:
+  NEXT(0);
+L_HALT:
+  return true;
+L_RET:
+  if (sp == 0) return true;
+  --sp;
+  pc = stack_[sp].pc;
+  base = stack_[sp].base;
+  mtop = stack_[sp].mstack_top;
+  DISPATCH();
+L_JMP:
+  pc = code + pc[1];
+  DISPATCH();
+L_JMPB:
+  BACKJUMP();
+  pc = code + pc[1];
+  DISPATCH();
+L_JMPF:
+  if (!ld<uint8_t>(base + pc[2])) {
+    pc = code + pc[1];
+    DISPATCH();
+  }
+  NEXT(2);
+L_JMPT:
+  if (ld<uint8_t>(base + pc[2])) {
+    pc = code + pc[1];
+    DISPATCH();
+  }
+  NEXT(2);
+L_CALL:
+  if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
+  stack_[sp++] = {pc + 3, base, mtop};
+  base += pc[1];
+  pc = code + pc[2];
+  DISPATCH();
+L_CALLA:
+  if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
+  stack_[sp++] = {pc + 3, base, mtop};
+  base = mem + pc[1];
+  pc = code + pc[2];
+  DISPATCH();
+L_CALLP: {
+  if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
+  PTR(addr, 1, 0, 8);
+  stack_[sp++] = {pc + 3, base, mtop};
+  base = mem + addr;
+  pc = code + pc[2];
+  DISPATCH();
+}
+L_FRAME:
+  W(uint32_t, 1, mtop);
+  NEXT(1);
+L_ENTER: {
+  uint64_t top = static_cast<uint64_t>(base - mem) + pc[1];
+  if (top > mend) return fail(TrapKind::CallDepth, pc, "method stack overflow (recursion?)");
+  mtop = static_cast<uint32_t>(top);
+  NEXT(1);
+}
+L_CALLS: {
+  if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
+  stack_[sp++] = {pc + 3, base, mtop};
+  base = mem + ld<uint32_t>(base + pc[1]);
+  pc = code + pc[2];
+  DISPATCH();
+}
+L_CALLV: {
+  if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
+  PTR(inst, 2, 0, 8);
+  uint32_t type = ld<uint16_t>(mem + inst);
+  uint32_t entry = type < n_types ? vtable[pc[3] * n_types + type] : 0;
+  if (entry == 0) return fail(TrapKind::NotImplemented, pc, "the instance's type does not implement this method");
+  uint8_t* frame = mem + ld<uint32_t>(base + pc[1]);
+  st<uint32_t>(frame + 8, static_cast<uint32_t>(inst));
+  stack_[sp++] = {pc + 4, base, mtop};
+  base = frame;
+  pc = code + entry;
+  DISPATCH();
+}
+L_JTAB: {
+  int64_t i = static_cast<int64_t>(ld<int32_t>(base + pc[1])) - static_cast<int32_t>(pc[2]);
+  if (i >= 0 && i < static_cast<int64_t>(pc[3])) pc = code + pc[5 + i];
+  else pc = code + pc[4];
+  DISPATCH();
+}
+L_COV:
+  taken[pc[1] >> 6] |= uint64_t(1) << (pc[1] & 63);
+  NEXT(1);
+L_FBENTER: {
+  st<uint32_t>(base + 4, ld<uint32_t>(base + 4) + 1);
+  if (base[2]) goto L_RET;
+  NEXT(0);
+}
+L_FNMOCK:
+  if (mem[pc[1]]) {
+    std::memcpy(base + pc[2], mem + pc[1] + 8, pc[3]);
+    goto L_RET;
+  }
+  NEXT(3);
+L_TRAP:
+  return fail(static_cast<TrapKind>(pc[1]), pc, trap_name(static_cast<TrapKind>(pc[1])));
+
+L_MOV1: W(uint8_t, 1, R(uint8_t, 2)); NEXT(2);
+L_MOV2: W(uint16_t, 1, R(uint16_t, 2)); NEXT(2);
+L_MOV4: W(uint32_t, 1, R(uint32_t, 2)); NEXT(2);
+L_MOV8: W(uint64_t, 1, R(uint64_t, 2)); NEXT(2);
+L_MOVN: std::memmove(base + pc[1], base + pc[2], pc[3]); NEXT(3);
+L_LDG1: W(uint8_t, 1, ld<uint8_t>(mem + pc[2])); NEXT(2);
+L_LDG2: W(uint16_t, 1, ld<uint16_t>(mem + pc[2])); NEXT(2);
+L_LDG4: W(uint32_t, 1, ld<uint32_t>(mem + pc[2])); NEXT(2);
+L_LDG8: W(uint64_t, 1, ld<uint64_t>(mem + pc[2])); NEXT(2);
+L_LDGN: std::memmove(base + pc[1], mem + pc[2], pc[3]); NEXT(3);
+L_STG1: st<uint8_t>(mem + pc[1], R(uint8_t, 2)); NEXT(2);
+L_STG2: st<uint16_t>(mem + pc[1], R(uint16_t, 2)); NEXT(2);
+L_STG4: st<uint32_t>(mem + pc[1], R(uint32_t, 2)); NEXT(2);
+L_STG8: st<uint64_t>(mem + pc[1], R(uint64_t, 2)); NEXT(2);
+L_STGN: std::memmove(mem + pc[1], base + pc[2], pc[3]); NEXT(3);
+L_LDI1: { PTR(p, 2, pc[3], 1); W(uint8_t, 1, ld<uint8_t>(mem + p)); NEXT(3); }
+L_LDI2: { PTR(p, 2, pc[3], 2); W(uint16_t, 1, ld<uint16_t>(mem + p)); NEXT(3); }
+L_LDI4: { PTR(p, 2, pc[3], 4); W(uint32_t, 1, ld<uint32_t>(mem + p)); NEXT(3); }
+L_LDI8: { PTR(p, 2, pc[3], 8); W(uint64_t, 1, ld<uint64_t>(mem + p)); NEXT(3); }
+L_LDIN: { PTR(p, 2, pc[3], pc[4]); std::memmove(base + pc[1], mem + p, pc[4]); NEXT(4); }
+L_STI1: { PTR(p, 1, pc[2], 1); st<uint8_t>(mem + p, R(uint8_t, 3)); NEXT(3); }
+L_STI2: { PTR(p, 1, pc[2], 2); st<uint16_t>(mem + p, R(uint16_t, 3)); NEXT(3); }
+L_STI4: { PTR(p, 1, pc[2], 4); st<uint32_t>(mem + p, R(uint32_t, 3)); NEXT(3); }
+L_STI8: { PTR(p, 1, pc[2], 8); st<uint64_t>(mem + p, R(uint64_t, 3)); NEXT(3); }
+L_STIN: { PTR(p, 1, pc[2], pc[4]); std::memmove(mem + p, base + pc[3], pc[4]); NEXT(4); }
+L_LDBIT: W(uint8_t, 1, static_cast<uint8_t>((mem[pc[2]] >> pc[3]) & 1u)); NEXT(3);
+L_STBIT: {
+  uint8_t m = static_cast<uint8_t>(1u << pc[2]);
+  mem[pc[1]] = static_cast<uint8_t>(R(uint8_t, 3) ? (mem[pc[1]] | m) : (mem[pc[1]] & ~m));
+  NEXT(3);
+}
+L_ADDR: W(uint32_t, 1, static_cast<uint32_t>(base - mem + pc[2])); NEXT(2);
+L_ADDRI: { PTR(p, 2, pc[3], 0); W(uint32_t, 1, static_cast<uint32_t>(p)); NEXT(3); }
+L_ADDRK: W(uint32_t, 1, pc[2]); NEXT(2);
+L_ELEM: {
+  int64_t i = static_cast<int64_t>(R(int32_t, 3)) - static_cast<int32_t>(pc[4]);
+  if (i < 0 || i >= static_cast<int64_t>(pc[5]))
+    return fail(TrapKind::IndexOutOfRange, pc,
+                fmt::format("index {} outside {}..{}", R(int32_t, 3), static_cast<int32_t>(pc[4]),
+                            static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1));
+  PTR(p, 2, static_cast<uint64_t>(i) * pc[6], 0);
+  W(uint32_t, 1, static_cast<uint32_t>(p));
+  NEXT(6);
+}
+L_INITBLK: std::memcpy(base + pc[1], mem + pc[2], pc[3]); NEXT(3);
+L_NOW: W(int64_t, 1, now_ns_); NEXT(1);
+L_ADVTIME: now_ns_ += R(int64_t, 1); NEXT(1);
+L_SETMOCK: { PTR(p, 1, 0, 8); mem[p + 2] = 1; NEXT(1); }
+L_NATIVE:
+  native(pc[1] & 0xffffu)(*this, pc[1] >> 16, base + pc[2], base + pc[3], base + pc[4], base + pc[5]);
+  NEXT(5);
+L_ASSERT:
+  if (!do_assert(pc, base)) return false;
+  NEXT(5);
+L_SCPY: {
+  const char* src = reinterpret_cast<const char*>(base + pc[2]);
+  size_t n = strnlen(src, pc[3]);
+  std::memmove(base + pc[1], src, n);
+  base[pc[1] + n] = 0;
+  NEXT(3);
+}
+L_SCMP: {
+  int c = std::strcmp(reinterpret_cast<const char*>(base + pc[2]), reinterpret_cast<const char*>(base + pc[3]));
+  bool r = false;
+  switch (pc[4]) {
+    case 0: r = c == 0; break;
+    case 1: r = c != 0; break;
+    case 2: r = c < 0; break;
+    case 3: r = c <= 0; break;
+    case 4: r = c > 0; break;
+    default: r = c >= 0; break;
+  }
+  W(uint8_t, 1, r);
+  NEXT(4);
+}
+L_GETBIT1: W(uint8_t, 1, static_cast<uint8_t>((R(uint8_t, 2) >> pc[3]) & 1u)); NEXT(3);
+L_GETBIT2: W(uint8_t, 1, static_cast<uint8_t>((R(uint16_t, 2) >> pc[3]) & 1u)); NEXT(3);
+L_GETBIT4: W(uint8_t, 1, static_cast<uint8_t>((R(uint32_t, 2) >> pc[3]) & 1u)); NEXT(3);
+L_GETBIT8: W(uint8_t, 1, static_cast<uint8_t>((R(uint64_t, 2) >> pc[3]) & 1u)); NEXT(3);
+#define SETBIT_IMPL(T)                                         \
+  {                                                            \
+    T m = static_cast<T>(T(1) << pc[2]);                       \
+    T v = R(T, 1);                                             \
+    W(T, 1, static_cast<T>(R(uint8_t, 3) ? (v | m) : (v & static_cast<T>(~m)))); \
+    NEXT(3);                                                   \
+  }
+L_SETBIT1: SETBIT_IMPL(uint8_t)
+L_SETBIT2: SETBIT_IMPL(uint16_t)
+L_SETBIT4: SETBIT_IMPL(uint32_t)
+L_SETBIT8: SETBIT_IMPL(uint64_t)
+#undef SETBIT_IMPL
+
+L_BAND: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) & R(uint8_t, 3))); NEXT(3);
+L_BOR: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) | R(uint8_t, 3))); NEXT(3);
+L_BXOR: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) ^ R(uint8_t, 3))); NEXT(3);
+L_BNOT: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) ^ 1u)); NEXT(2);
+L_TOBOOL8: W(uint8_t, 1, R(uint8_t, 2) != 0); NEXT(2);
+L_TOBOOL16: W(uint8_t, 1, R(uint16_t, 2) != 0); NEXT(2);
+L_TOBOOL32: W(uint8_t, 1, R(uint32_t, 2) != 0); NEXT(2);
+L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
+
+#define NUM_IMPL(TN, C)                                                                 \
+  L_ADD_##TN: W(C, 1, wadd<C>(R(C, 2), R(C, 3))); NEXT(3);                              \
+  L_SUB_##TN: W(C, 1, wsub<C>(R(C, 2), R(C, 3))); NEXT(3);                              \
+  L_MUL_##TN: W(C, 1, wmul<C>(R(C, 2), R(C, 3))); NEXT(3);                              \
+  L_DIV_##TN: {                                                                         \
+    C d = R(C, 3);                                                                      \
+    if constexpr (std::is_integral_v<C>) {                                              \
+      if (d == C(0)) return fail(TrapKind::DivisionByZero, pc, "integer division by zero"); \
+      W(C, 1, wdiv<C>(R(C, 2), d));                                                     \
+    } else {                                                                            \
+      W(C, 1, static_cast<C>(R(C, 2) / d));                                             \
+    }                                                                                   \
+    NEXT(3);                                                                            \
+  }                                                                                     \
+  L_NEG_##TN: W(C, 1, wneg<C>(R(C, 2))); NEXT(2);                                       \
+  L_EQ_##TN: W(uint8_t, 1, R(C, 2) == R(C, 3)); NEXT(3);                                \
+  L_NE_##TN: W(uint8_t, 1, R(C, 2) != R(C, 3)); NEXT(3);                                \
+  L_LT_##TN: W(uint8_t, 1, R(C, 2) < R(C, 3)); NEXT(3);                                 \
+  L_LE_##TN: W(uint8_t, 1, R(C, 2) <= R(C, 3)); NEXT(3);                                \
+  L_GT_##TN: W(uint8_t, 1, R(C, 2) > R(C, 3)); NEXT(3);                                 \
+  L_GE_##TN: W(uint8_t, 1, R(C, 2) >= R(C, 3)); NEXT(3);                                \
+  L_JLT_##TN: if (R(C, 2) < R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);        \
+  L_JGE_##TN: if (R(C, 2) >= R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);       \
+  L_JEQ_##TN: if (R(C, 2) == R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);       \
+  L_JNE_##TN: if (R(C, 2) != R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);       \
+  L_MIN_##TN: { C x = R(C, 2), y = R(C, 3); W(C, 1, y < x ? y : x); NEXT(3); }          \
+  L_MAX_##TN: { C x = R(C, 2), y = R(C, 3); W(C, 1, x < y ? y : x); NEXT(3); }          \
+  L_ABS_##TN: W(C, 1, wabs<C>(R(C, 2))); NEXT(2);                                       \
+  L_CVT_##TN##_I8: W(int8_t, 1, cvt<int8_t>(R(C, 2))); NEXT(2);                         \
+  L_CVT_##TN##_I16: W(int16_t, 1, cvt<int16_t>(R(C, 2))); NEXT(2);                      \
+  L_CVT_##TN##_I32: W(int32_t, 1, cvt<int32_t>(R(C, 2))); NEXT(2);                      \
+  L_CVT_##TN##_I64: W(int64_t, 1, cvt<int64_t>(R(C, 2))); NEXT(2);                      \
+  L_CVT_##TN##_U8: W(uint8_t, 1, cvt<uint8_t>(R(C, 2))); NEXT(2);                       \
+  L_CVT_##TN##_U16: W(uint16_t, 1, cvt<uint16_t>(R(C, 2))); NEXT(2);                    \
+  L_CVT_##TN##_U32: W(uint32_t, 1, cvt<uint32_t>(R(C, 2))); NEXT(2);                    \
+  L_CVT_##TN##_U64: W(uint64_t, 1, cvt<uint64_t>(R(C, 2))); NEXT(2);                    \
+  L_CVT_##TN##_F32: W(float, 1, cvt<float>(R(C, 2))); NEXT(2);                          \
+  L_CVT_##TN##_F64: W(double, 1, cvt<double>(R(C, 2))); NEXT(2);
+  PLCFI_NUM_TYPES(NUM_IMPL)
+#undef NUM_IMPL
+
+#define INT_IMPL(TN, C)                                                                  \
+  L_MOD_##TN: {                                                                          \
+    C d = R(C, 3);                                                                       \
+    if (d == C(0)) return fail(TrapKind::DivisionByZero, pc, "MOD by zero");             \
+    W(C, 1, wmod<C>(R(C, 2), d));                                                        \
+    NEXT(3);                                                                             \
+  }                                                                                      \
+  L_AND_##TN: W(C, 1, static_cast<C>(R(C, 2) & R(C, 3))); NEXT(3);                       \
+  L_OR_##TN: W(C, 1, static_cast<C>(R(C, 2) | R(C, 3))); NEXT(3);                        \
+  L_XOR_##TN: W(C, 1, static_cast<C>(R(C, 2) ^ R(C, 3))); NEXT(3);                       \
+  L_NOT_##TN: W(C, 1, static_cast<C>(~R(C, 2))); NEXT(2);                                \
+  L_SHL_##TN: W(C, 1, shl<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
+  L_SHR_##TN: W(C, 1, shr<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
+  L_ROL_##TN: W(C, 1, rol<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
+  L_ROR_##TN: W(C, 1, ror<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
+  L_CHK_##TN: {                                                                          \
+    C v = R(C, 1), lo = R(C, 2), hi = R(C, 3);                                           \
+    if (v < lo || v > hi)                                                                \
+      return fail(TrapKind::RangeError, pc,                                              \
+                  fmt::format("value {} outside subrange {}..{}", +v, +lo, +hi));        \
+    NEXT(4);                                                                             \
+  }                                                                                      \
+  L_LOOPUP_##TN: {                                                                       \
+    C v;                                                                                 \
+    bool ovf = __builtin_add_overflow(R(C, 1), R(C, 2), &v);                             \
+    W(C, 1, v);                                                                          \
+    if (!ovf && v <= R(C, 3)) {                                                          \
+      BACKJUMP();                                                                        \
+      pc = code + pc[4];                                                                 \
+      DISPATCH();                                                                        \
+    }                                                                                    \
+    NEXT(4);                                                                             \
+  }                                                                                      \
+  L_LOOPDN_##TN: {                                                                       \
+    C v;                                                                                 \
+    bool ovf = __builtin_add_overflow(R(C, 1), R(C, 2), &v);                             \
+    W(C, 1, v);                                                                          \
+    if (!ovf && v >= R(C, 3)) {                                                          \
+      BACKJUMP();                                                                        \
+      pc = code + pc[4];                                                                 \
+      DISPATCH();                                                                        \
+    }                                                                                    \
+    NEXT(4);                                                                             \
+  }
+  PLCFI_INT_TYPES(INT_IMPL)
+#undef INT_IMPL
+
+L_ROUND_F32: W(float, 1, std::round(R(float, 2))); NEXT(2);
+L_ROUND_F64: W(double, 1, std::round(R(double, 2))); NEXT(2);
+L_TRUNC_F32: W(float, 1, std::trunc(R(float, 2))); NEXT(2);
+L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
+
+#define LDX_IMPL(N, T)                                                                         \
+  L_LDX##N: {                                                                                  \
+    int64_t i = static_cast<int64_t>(R(int32_t, 3)) - static_cast<int32_t>(pc[4]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int32_t, 3), static_cast<int32_t>(pc[4]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
+    W(T, 1, ld<T>(base + pc[2] + i * N));                                                      \
+    NEXT(5);                                                                                   \
+  }                                                                                            \
+  L_STX##N: {                                                                                  \
+    int64_t i = static_cast<int64_t>(R(int32_t, 2)) - static_cast<int32_t>(pc[3]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int32_t, 2), static_cast<int32_t>(pc[3]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
+    st<T>(base + pc[1] + i * N, R(T, 5));                                                      \
+    NEXT(5);                                                                                   \
+  }
+  LDX_IMPL(1, uint8_t)
+  LDX_IMPL(2, uint16_t)
+  LDX_IMPL(4, uint32_t)
+  LDX_IMPL(8, uint64_t)
+#undef LDX_IMPL
+
+#undef DISPATCH
+#undef NEXT
+#undef R
+#undef W
+#undef PTR
+#undef BACKJUMP
+}
+
+// ----------------------------------------------------------------- assertions
+
+namespace {
+std::string format_value(ValueKind k, const uint8_t* p) {
+  switch (k) {
+    case ValueKind::Bool: return *p ? "TRUE" : "FALSE";
+    case ValueKind::I8: return std::to_string(ld<int8_t>(p));
+    case ValueKind::I16: return std::to_string(ld<int16_t>(p));
+    case ValueKind::I32: return std::to_string(ld<int32_t>(p));
+    case ValueKind::I64: case ValueKind::Enum: return std::to_string(ld<int64_t>(p));
+    case ValueKind::U8: return std::to_string(ld<uint8_t>(p));
+    case ValueKind::U16: return std::to_string(ld<uint16_t>(p));
+    case ValueKind::U32: case ValueKind::Ref: return std::to_string(ld<uint32_t>(p));
+    case ValueKind::U64: return std::to_string(ld<uint64_t>(p));
+    case ValueKind::F32: return fmt::format("{}", ld<float>(p));
+    case ValueKind::F64: return fmt::format("{}", ld<double>(p));
+    case ValueKind::Time: {
+      int64_t ns = ld<int64_t>(p);
+      if (ns % 1'000'000 == 0) return fmt::format("T#{}ms", ns / 1'000'000);
+      return fmt::format("T#{}ns", ns);
+    }
+    case ValueKind::Date: case ValueKind::Tod: case ValueKind::Dt:
+      return std::to_string(ld<int64_t>(p)) + "ns";
+    case ValueKind::String: return "'" + std::string(reinterpret_cast<const char*>(p)) + "'";
+  }
+  return "?";
+}
+
+template <class T>
+int cmp3(const uint8_t* a, const uint8_t* b) {
+  T x = ld<T>(a), y = ld<T>(b);
+  return x < y ? -1 : (y < x ? 1 : 0);
+}
+
+int compare(ValueKind k, const uint8_t* a, const uint8_t* b) {
+  switch (k) {
+    case ValueKind::Bool: case ValueKind::U8: return cmp3<uint8_t>(a, b);
+    case ValueKind::I8: return cmp3<int8_t>(a, b);
+    case ValueKind::I16: return cmp3<int16_t>(a, b);
+    case ValueKind::I32: return cmp3<int32_t>(a, b);
+    case ValueKind::I64: case ValueKind::Time: case ValueKind::Date: case ValueKind::Tod:
+    case ValueKind::Dt: case ValueKind::Enum: return cmp3<int64_t>(a, b);
+    case ValueKind::U16: return cmp3<uint16_t>(a, b);
+    case ValueKind::U32: case ValueKind::Ref: return cmp3<uint32_t>(a, b);
+    case ValueKind::U64: return cmp3<uint64_t>(a, b);
+    case ValueKind::F32: return cmp3<float>(a, b);
+    case ValueKind::F64: return cmp3<double>(a, b);
+    case ValueKind::String: {
+      int c = std::strcmp(reinterpret_cast<const char*>(a), reinterpret_cast<const char*>(b));
+      return c < 0 ? -1 : (c > 0 ? 1 : 0);
+    }
+  }
+  return 0;
+}
+}  // namespace
+
+bool Machine::do_assert(const uint32_t* pc, uint8_t* base) {
+  auto kind = static_cast<AssertKind>(pc[1] >> 8);
+  auto vk = static_cast<ValueKind>(pc[1] & 0xffu);
+  const uint8_t* a = base + pc[2];
+  const uint8_t* b = base + pc[3];
+  bool ok = true;
+  std::string msg;
+  switch (kind) {
+    case AssertKind::True:
+    case AssertKind::False: {
+      bool v = *a != 0;
+      ok = kind == AssertKind::True ? v : !v;
+      if (!ok) msg = fmt::format("expected {}, actual {}", kind == AssertKind::True ? "TRUE" : "FALSE", v ? "TRUE" : "FALSE");
+      break;
+    }
+    case AssertKind::Near: {
+      double x = vk == ValueKind::F32 ? ld<float>(a) : ld<double>(a);
+      double y = vk == ValueKind::F32 ? ld<float>(b) : ld<double>(b);
+      double tol = ld<double>(base + pc[4]);
+      ok = std::fabs(x - y) <= tol;
+      if (!ok) msg = fmt::format("expected {} +/- {}, actual {}", x, tol, y);
+      break;
+    }
+    case AssertKind::Called:
+    case AssertKind::CallCount: {
+      uint32_t inst = ld<uint32_t>(a);
+      if (inst == 0 || inst + 8 > mem_.size()) return fail(TrapKind::NullReference, pc, "not an FB instance");
+      uint32_t count = ld<uint32_t>(mem_.data() + inst + 4);
+      if (kind == AssertKind::Called) {
+        ok = count > 0;
+        if (!ok) msg = "expected the mocked instance to be called, it was not";
+      } else {
+        int64_t want = ld<int64_t>(b);
+        ok = static_cast<int64_t>(count) == want;
+        if (!ok) msg = fmt::format("expected {} calls, actual {}", want, count);
+      }
+      break;
+    }
+    default: {
+      int c = compare(vk, a, b);
+      const char* rel = "";
+      switch (kind) {
+        case AssertKind::Eq: ok = c == 0; rel = "="; break;
+        case AssertKind::Neq: ok = c != 0; rel = "<>"; break;
+        case AssertKind::Gt: ok = c > 0; rel = ">"; break;
+        case AssertKind::Lt: ok = c < 0; rel = "<"; break;
+        case AssertKind::Ge: ok = c >= 0; rel = ">="; break;
+        case AssertKind::Le: ok = c <= 0; rel = "<="; break;
+        default: break;
+      }
+      if (!ok) {
+        if (kind == AssertKind::Eq)
+          msg = fmt::format("expected {}, actual {}", format_value(vk, a), format_value(vk, b));
+        else
+          msg = fmt::format("expected {} {} {}", format_value(vk, a), rel, format_value(vk, b));
+      }
+      break;
+    }
+  }
+  if (ok) return true;
+  // A trailing message string, when given, is in slot e (0 = none).
+  if (pc[5] != 0) msg += fmt::format(" ({})", reinterpret_cast<const char*>(base + pc[5]));
+  assert_message_ = msg;
+  return fail(TrapKind::AssertFailed, pc, msg);
+}
+
+}  // namespace plcfi::st

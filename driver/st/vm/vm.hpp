@@ -1,0 +1,102 @@
+// The bytecode virtual machine: runs entries of an Application over flat memory.
+// Contract: single-threaded; call() never allocates on the heap unless a trap or a failed
+// assertion has to be described; every runtime error becomes a Trap with the ST location.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "program.hpp"
+
+namespace plcfi::st {
+
+enum class TrapKind : uint8_t {
+  None,
+  DivisionByZero,
+  IndexOutOfRange,
+  RangeError,       // subrange violation
+  NullReference,
+  Watchdog,         // instruction budget of the scan exhausted
+  CallDepth,
+  AssertFailed,     // test files
+  NotImplemented,   // abstract method or interface without an implementation
+  BadAddress,       // an address outside VM memory (corrupt reference)
+};
+const char* trap_name(TrapKind k);
+
+struct Trap {
+  TrapKind kind = TrapKind::None;
+  uint32_t pc = 0;
+  SourceLoc loc;
+  std::string message;  // the what, without the location
+};
+
+class Machine;
+// Natives implement the standard functions the compiler does not open-code
+// (string functions, transcendental math, conversions to and from text).
+using NativeFn = void (*)(Machine& m, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d);
+NativeFn native(uint32_t id);
+const char* native_name(uint32_t id);
+
+// Value kinds named in ASSERT instructions so failures print readable values.
+enum class ValueKind : uint8_t { Bool, I8, I16, I32, I64, U8, U16, U32, U64, F32, F64, Time, Date, Tod, Dt, String, Enum, Ref };
+enum class AssertKind : uint8_t { Eq, Neq, True, False, Gt, Lt, Ge, Le, Near, Called, CallCount };
+
+class Machine {
+ public:
+  explicit Machine(const Application& app);
+
+  // Memory := the application's cold-start image (all variables to initial values).
+  void cold_restart();
+  // Like cold_restart, but RETAIN variables keep their values.
+  void warm_restart();
+
+  // Runs code at `entry` with base = absolute address `base_addr` until it returns.
+  // Returns false on a trap (see trap()); memory stays consistent and the machine usable.
+  bool call(uint32_t entry, uint32_t base_addr);
+  const Trap& trap() const { return trap_; }
+
+  int64_t now() const { return now_ns_; }
+  void set_now(int64_t ns) { now_ns_ = ns; }
+  // Backward jumps and loop iterations allowed per call() before a Watchdog trap.
+  void set_budget(uint64_t budget) { budget_limit_ = budget; }
+
+  uint8_t* mem() { return mem_.data(); }
+  const uint8_t* mem() const { return mem_.data(); }
+  size_t mem_size() const { return mem_.size(); }
+  const Application& app() const { return *app_; }
+
+  // Branch coverage: bit i set when branch id i was taken since the last clear.
+  const std::vector<uint64_t>& taken() const { return taken_; }
+  void clear_taken();
+  // Cumulative coverage since construction (merged by merge_coverage()).
+  const std::vector<uint64_t>& covered() const { return covered_; }
+  void merge_coverage();
+
+  // Assertion bookkeeping for the test runner.
+  const std::string& assert_message() const { return assert_message_; }
+
+ private:
+  friend struct VmAccess;
+  bool fail(TrapKind k, const uint32_t* pc, std::string msg);
+  bool run(const uint32_t* pc, uint8_t* base);
+  bool do_assert(const uint32_t* pc, uint8_t* base);
+
+  const Application* app_;
+  std::vector<uint8_t> mem_;
+  std::vector<uint64_t> taken_, covered_;
+  int64_t now_ns_ = 0;
+  uint64_t budget_limit_ = 100'000'000;
+  Trap trap_;
+  std::string assert_message_;
+  struct Frame {
+    const uint32_t* pc;
+    uint8_t* base;
+    uint32_t mstack_top;
+  };
+  static constexpr size_t kMaxDepth = 256;
+  Frame stack_[kMaxDepth];
+};
+
+}  // namespace plcfi::st
