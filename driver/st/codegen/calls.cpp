@@ -92,7 +92,7 @@ Val Compiler::native(Native n, const Type* result, std::initializer_list<Slot> a
   size_t i = 0;
   for (Slot s : args) a[i++] = Arg(s);
   emit(Op::NATIVE, {static_cast<uint32_t>(n) | (cap << 16), d, a[0], a[1], a[2]});
-  def(d);
+  def(d, 2);
   Val v;
   v.type = result;
   v.slot = d;
@@ -552,7 +552,8 @@ std::optional<Val> Compiler::conversion(const std::string& name, const CallExpr&
   };
   Val out;
   out.type = to;
-  TypeKind fk = from->kind == TypeKind::Enum ? from->base->kind : from->kind;
+  if (from->kind == TypeKind::Enum) from = from->base;  // TO_INT(enum value)
+  TypeKind fk = from->kind;
   TypeKind tk = to->kind;
   bool from_dur_ms = fk == TypeKind::Time;
   bool to_dur_ms = tk == TypeKind::Time;
@@ -844,6 +845,51 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
     Val out;
     out.type = t;
     out.slot = d;
+    return out;
+  }
+  // Functional forms of the operators (ADD, GT, ...) and the named time functions.
+  static const std::pair<const char*, BinaryOp> kOps[] = {
+      {"ADD", BinaryOp::Add}, {"SUB", BinaryOp::Sub}, {"MUL", BinaryOp::Mul}, {"DIV", BinaryOp::Div},
+      {"MOD", BinaryOp::Mod}, {"AND", BinaryOp::And}, {"OR", BinaryOp::Or},   {"XOR", BinaryOp::Xor},
+      {"GT", BinaryOp::Gt},   {"GE", BinaryOp::Ge},   {"EQ", BinaryOp::Eq},   {"LE", BinaryOp::Le},
+      {"LT", BinaryOp::Lt},   {"NE", BinaryOp::Ne},   {"ADD_TIME", BinaryOp::Add}, {"SUB_TIME", BinaryOp::Sub},
+      {"MUL_TIME", BinaryOp::Mul}, {"DIV_TIME", BinaryOp::Div}, {"ADD_TOD_TIME", BinaryOp::Add},
+      {"ADD_DT_TIME", BinaryOp::Add}, {"SUB_TOD_TIME", BinaryOp::Sub}, {"SUB_DT_TIME", BinaryOp::Sub},
+      {"SUB_DATE_DATE", BinaryOp::Sub}, {"SUB_TOD_TOD", BinaryOp::Sub}, {"SUB_DT_DT", BinaryOp::Sub},
+      {"ADD_LTIME", BinaryOp::Add}, {"SUB_LTIME", BinaryOp::Sub}, {"MUL_LTIME", BinaryOp::Mul}, {"DIV_LTIME", BinaryOp::Div},
+  };
+  for (auto [fn, op] : kOps) {
+    if (name != fn) continue;
+    bool extensible = op == BinaryOp::Add || op == BinaryOp::Mul || op == BinaryOp::And || op == BinaryOp::Or || op == BinaryOp::Xor;
+    auto args = positional(c, 2, extensible && name.find('_') == std::string::npos ? SIZE_MAX : 2, fn);
+    if (args.empty()) return bad();
+    Val acc = expr(*args[0]);
+    for (size_t i = 1; i < args.size() && acc.ok; ++i) {
+      Val next = expr(*args[i], acc.type && acc.type->kind == TypeKind::Enum ? acc.type : nullptr);
+      if (!next.ok) return bad();
+      acc = combine(op, acc, next, c.loc);
+    }
+    return acc;
+  }
+  if (name == "CONCAT_DATE_TOD") {
+    auto args = positional(c, 2, 2, "CONCAT_DATE_TOD");
+    if (args.empty()) return bad();
+    Val d = expr(*args[0]);
+    Val t = expr(*args[1]);
+    if (!d.ok || !t.ok) return bad();
+    if (!d.type || d.type->kind != TypeKind::Date || !t.type || t.type->kind != TypeKind::TimeOfDay) {
+      diags_.error("ST203", c.loc, "CONCAT_DATE_TOD needs a DATE and a TIME_OF_DAY");
+      return bad();
+    }
+    const Type* I64 = elem(TypeKind::LInt);
+    Slot a = d.is_const ? konst(I64, d.c, c.loc) : d.slot;
+    Slot b = t.is_const ? konst(I64, t.c, c.loc) : t.slot;
+    Slot r = temp(8, 8);
+    emit(Op::ADD_I64, {r, a, b});
+    def(r);
+    Val out;
+    out.type = elem(TypeKind::DateTime);
+    out.slot = r;
     return out;
   }
   if (name == "MOVE") {

@@ -124,8 +124,9 @@ Compiler::Compiler(const SourceManager& sm, DiagEngine& diags, const CompileOpti
 
 void Compiler::emit(Op op, std::initializer_list<Arg> args) { emit_list(op, std::vector<Arg>(args)); }
 
-void Compiler::def(Slot dst) {
+void Compiler::def(Slot dst, uint32_t operand) {
   b_->last_def = dst;
+  b_->last_def_operand = operand;
   // The instruction just emitted starts at code.size() - 1 - operands.
   b_->last_def_pos = b_->last_instr;
 }
@@ -133,7 +134,7 @@ void Compiler::def(Slot dst) {
 bool Compiler::retarget(Slot from, Slot to) {
   if (b_->last_def_pos != b_->last_instr || b_->last_label_pos > b_->last_instr) return false;
   if (b_->last_def.off != from.off || b_->last_def.kind != from.kind || from.kind != SK::Temp) return false;
-  uint32_t word = b_->last_def_pos + 1;
+  uint32_t word = b_->last_def_pos + b_->last_def_operand;
   auto it = std::find_if(b_->slot_fix.begin(), b_->slot_fix.end(), [&](const auto& e) { return e.first == word; });
   if (it != b_->slot_fix.end()) b_->slot_fix.erase(it);
   b_->code[word] = to.off;
@@ -263,6 +264,7 @@ void Compiler::compile_pou(PouInfo* p) {
 
   std::vector<uint32_t> entries;
   // Prologue.
+  mark(decl ? decl->loc : SourceLoc{});
   if (p->kind == PouKind::Method) {
     emit(Op::ENTER, {0u});
     b_->template_fix.push_back(static_cast<uint32_t>(b_->code.size() - 1) | 0x80000000u);  // frame size
@@ -274,8 +276,8 @@ void Compiler::compile_pou(PouInfo* p) {
     p->mock_addr = alloc(8 + rsize, 8);
     emit(Op::FNMOCK, {p->mock_addr, p->result_offset, rsize});
   }
-  bool has_tmpl = p->kind == PouKind::Method || ((p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) &&
-                                                 p->init_from < b_->vars_end);
+  bool has_temp_vars = std::any_of(p->vars.begin(), p->vars.end(), [](const auto& v) { return v->section == VarSection::Temp; });
+  bool has_tmpl = p->kind == PouKind::Method || ((p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) && has_temp_vars);
   if (has_tmpl) {
     emit(Op::INITBLK, {p->init_from, 0u, 0u});
     b_->template_fix.push_back(static_cast<uint32_t>(b_->code.size() - 2));
@@ -329,8 +331,9 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
     p->type->size = frame_size;
     p->type->align = 8;
     p->type->init = image;
+    bool has_temp_vars = std::any_of(p->vars.begin(), p->vars.end(), [](const auto& v) { return v->section == VarSection::Temp; });
     p->tmpl_from = p->init_from;
-    p->tmpl_to = b.vars_end;
+    p->tmpl_to = has_temp_vars ? b.vars_end : p->init_from;
   } else if (p->kind == PouKind::Function) {
     p->tmpl_from = 0;
     p->tmpl_to = temp_base;
@@ -473,6 +476,21 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
         p->base = nullptr;
         break;
       }
+  }
+
+  // Global constants are known by name before any declaration needs them (array bounds).
+  for (const auto* u : all) {
+    auto note = [&](const std::vector<VarBlock>& blocks) {
+      for (const auto& blk : blocks)
+        for (const auto& d : blk.decls)
+          if (d.constant)
+            for (const auto& n : d.names) global_consts_[canon(n.text)] = {&d, u->file};
+    };
+    note(u->globals);
+    for (const auto& c : u->configs) {
+      note(c.globals);
+      for (const auto& r : c.resources) note(r.globals);
+    }
   }
 
   // Globals: global variable lists (scope: file stem), configurations and resources.

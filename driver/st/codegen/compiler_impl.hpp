@@ -108,6 +108,7 @@ struct Body {
   // The last instruction that only defined a temporary, so a following store can
   // retarget it to the variable instead of copying (x := a + b is one ADD).
   uint32_t last_def_pos = UINT32_MAX;
+  uint32_t last_def_operand = 1;
   Slot last_def;
   uint32_t last_label_pos = 0;
   uint32_t last_instr = UINT32_MAX;
@@ -153,7 +154,7 @@ class Compiler {
   void finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries);
   void emit(Op op, std::initializer_list<Arg> args);
   void emit_list(Op op, const std::vector<Arg>& args);
-  void def(Slot dst);  // records that the instruction just emitted only wrote dst
+  void def(Slot dst, uint32_t operand = 1);  // the instruction just emitted only wrote dst (its n-th operand)
   bool retarget(Slot from, Slot to);
   Val expr_for(const Expr& e, const Type* target);
   Label new_label();
@@ -180,6 +181,7 @@ class Compiler {
   // ---- expressions (expr.cpp)
   Val expr(const Expr& e, const Type* expected = nullptr);
   Val binary(const BinaryExpr& e, const Type* expected);
+  Val combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc);
   Val unary(const UnaryExpr& e, const Type* expected);
   Val literal(const LiteralExpr& e, const Type* expected);
   Place place(const Expr& e, bool for_write);
@@ -248,6 +250,8 @@ class Compiler {
   std::vector<std::pair<uint32_t, PouInfo*>> entry_fix_;  // absolute code index -> POU entry
   std::unordered_map<std::string, std::unique_ptr<Symbol>> enum_syms_;
   const Type* null_type_ = nullptr;
+  const PouInfo* decl_pou_ = nullptr;  // POU whose declarations are being laid out
+  std::unordered_map<std::string, std::pair<const VarDecl*, uint32_t>> global_consts_;
   std::vector<std::unique_ptr<Body>> bodies_;  // finished bodies waiting for final layout
   std::vector<std::pair<Body*, std::vector<uint32_t>*>> pending_;
   Body* b_ = nullptr;  // body being compiled

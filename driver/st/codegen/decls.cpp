@@ -272,7 +272,8 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
       t->lo = *lo;
       t->hi = *hi;
       t->init.assign(t->size, 0);
-      if (*lo > 0 || *hi < 0) write_const(t->init.data(), base, ConstV{ConstV::K::Int, *lo, 0, {}}, spec.loc);
+      // IEC 61131-3: a subrange's default initial value is its lower limit.
+      write_const(t->init.data(), base, ConstV{ConstV::K::Int, *lo, 0, {}}, spec.loc);
       result = t;
       break;
     }
@@ -381,6 +382,22 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
           c->r = static_cast<double>(c->i);
         }
         return c;
+      }
+      if (!s || s->kind != SymKind::Var) {
+        // Constants not laid out yet: the POU's own (ARRAY[1..N] before N's block) and globals.
+        auto const_init = [&](const VarDecl& d) -> const Expr* {
+          if (!d.constant || !d.init) return nullptr;
+          for (const auto& nm : d.names)
+            if (iequals(nm.text, n.name.text)) return d.init.get();
+          return nullptr;
+        };
+        if (decl_pou_)
+          for (const VarBlock* blk : decl_pou_->blocks)
+            for (const auto& d : blk->decls)
+              if (const Expr* init = const_init(d)) return const_eval(*init, decl_pou_->file, report);
+        auto gc = global_consts_.find(key);
+        if (gc != global_consts_.end() && const_init(*gc->second.first))
+          return const_eval(*const_init(*gc->second.first), gc->second.second, report);
       }
       if (!s) {
         auto it = enum_values_.find(key);
@@ -727,6 +744,8 @@ void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::s
 
 // Creates the symbols of a POU's variables and lays out its instance or frame.
 void Compiler::declare_vars(PouInfo* p) {
+  const PouInfo* saved_decl_pou = decl_pou_;
+  decl_pou_ = p;
   uint32_t off = 8;
   if (p->kind == PouKind::Method) off = 12;  // [8..12): THIS
   if (p->base) off = align_up(p->base->frame_size, 8);
@@ -774,7 +793,22 @@ void Compiler::declare_vars(PouInfo* p) {
         off += rt->size;
       }
     }
-    if (!is_callable && sec == VarSection::Temp) p->init_from = align_up(off, 8);
+    if (!is_callable && sec == VarSection::Temp) p->init_from = off;
+    if (sec == VarSection::Input && p->is_setter && p->property) {
+      // A property setter receives the new value under the property's name.
+      const Type* t = p->property->type ? resolve_type(*p->property->type, p->file) : nullptr;
+      if (t) {
+        auto s = std::make_unique<Symbol>();
+        s->name = p->property->name.text;
+        s->type = t;
+        s->section = VarSection::Input;
+        s->loc = p->property->name.loc;
+        s->reads = 1;
+        place_var(s.get(), t->size, t->align);
+        p->inputs.push_back(s.get());
+        p->vars.push_back(std::move(s));
+      }
+    }
     for (const VarBlock* blkp : p->blocks) {
       const VarBlock& blk = *blkp;
       if (blk.section != sec) continue;
@@ -842,6 +876,7 @@ void Compiler::declare_vars(PouInfo* p) {
     }
   }
   p->frame_size = align_up(off, 8);
+  decl_pou_ = saved_decl_pou;
   // FB and PROGRAM types expose their variables as fields (paths, member access).
   if (p->type && p->kind != PouKind::Interface) {
     Type* t = p->type;

@@ -337,6 +337,13 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
     return bad_place;
   }
   const Field* f = t->field(member.text);
+  if (!f && t->kind == TypeKind::Pou && t->pou) {
+    // Located variables of an instance live in the I/O image.
+    if (Symbol* s = t->pou->find_var(member.text); s && (s->where == Where::Abs || s->where == Where::AbsBit)) {
+      ++s->reads;
+      return symbol_place(s, loc);
+    }
+  }
   if (!f) {
     diags_.error("ST207", member.loc, "'" + t->name + "' has no member '" + member.text + "'");
     return bad_place;
@@ -644,11 +651,13 @@ Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* wh
   }
   if (v.type == to || implicitly_converts(v.type, to) || (v.type->is_string() && to->is_string()) ||
       (v.type->kind == TypeKind::Ref && to->kind == TypeKind::Ref && same_type(v.type, to))) {
+    // A constant takes the target type; a computed value keeps its own type so that
+    // to_slot() knows what to convert from.
     if (v.is_const && to->is_elementary()) {
       std::vector<uint8_t> buf(to->size ? to->size : 1);
       if (!write_const(buf.data(), to, v.c, loc)) return bad();
+      out.type = to;
     }
-    out.type = to;
     return out;
   }
   if (v.type->kind == TypeKind::Interface && to->kind == TypeKind::Interface && v.type->pou && to->pou &&
@@ -843,7 +852,10 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
             return v;
           }
         }
-        if (!s && b_ && b_->this_type && b_->this_type->pou) {
+        bool is_result = b_ && b_->pou && ((b_->pou->property && iequals(b_->pou->property->name.text, key)) ||
+                                           ((b_->pou->kind == PouKind::Function || b_->pou->kind == PouKind::Method) &&
+                                            iequals(b_->pou->name, key)));
+        if (!s && !is_result && b_ && b_->this_type && b_->this_type->pou) {
           // A property of the instance itself, read by its bare name.
           if (PouInfo* g = b_->this_type->pou->find_method("__GET_" + key)) {
             Place self = this_place(e.loc);
@@ -973,6 +985,15 @@ Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
   if (!l.ok) return bad();
   Val r = expr(*e.rhs, l.type && l.type->kind == TypeKind::Enum ? l.type : (is_cmp(e.op) ? nullptr : expected));
   if (!r.ok) return bad();
+  return combine(e.op, l, r, e.loc);
+}
+
+Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
+  // The operator and where it stands (named time functions pass their call's location).
+  const struct {
+    BinaryOp op;
+    SourceLoc loc;
+  } e{op, loc};
   if (l.is_const && !l.type && r.type && r.type->kind == TypeKind::Enum) {
     diags_.error("ST204", e.loc, "cannot compare an integer with enumeration " + r.type->name);
     return bad();
@@ -983,7 +1004,8 @@ Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
   };
   // Constant folding (untyped or typed elementary constants).
   if (l.is_const && r.is_const && l.c.k != ConstV::K::Str && r.c.k != ConstV::K::Str &&
-      (!l.type || l.type->is_elementary()) && (!r.type || r.type->is_elementary())) {
+      (!l.type || (l.type->is_elementary() && !l.type->is_time_like())) &&
+      (!r.type || (r.type->is_elementary() && !r.type->is_time_like()))) {
     const Type* t = nullptr;
     if (l.type && r.type) {
       t = common_type(*tt_, l.type, r.type);
@@ -1031,6 +1053,7 @@ Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
     return v;
   };
   auto operand = [&](const Val& v, const Type* t) -> Slot {
+    if (v.is_const && v.type && v.type->is_time_like()) return konst(t, v.c, e.loc);
     if (v.is_const) {
       Val c = coerce(v.type ? v : Val{nullptr, true, true, v.c, {}}, t, e.loc, nullptr);
       if (!c.ok) return Slot{};
@@ -1085,8 +1108,8 @@ Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
   // Strings: comparisons only.
   if (lt->is_string() || rt->is_string()) {
     if (!lt->is_string() || !rt->is_string() || !is_cmp(e.op)) return op_error();
-    Slot a = l.is_const ? konst(lt, l.c, e.lhs->loc) : l.slot;
-    Slot b = r.is_const ? konst(rt, r.c, e.rhs->loc) : r.slot;
+    Slot a = l.is_const ? konst(lt, l.c, e.loc) : l.slot;
+    Slot b = r.is_const ? konst(rt, r.c, e.loc) : r.slot;
     Slot d = temp(1, 1);
     static const uint32_t kRel[] = {2, 4, 3, 5, 0, 1};  // Lt Gt Le Ge Eq Ne -> SCMP relation
     emit(Op::SCMP, {d, a, b, kRel[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)]});

@@ -156,7 +156,9 @@ void Compiler::assign_stmt(const AssignStmt& s) {
   }
   if (s.lhs->kind == ExprKind::Name && b_->this_type && b_->this_type->pou) {
     std::string key = canon(static_cast<const NameExpr&>(*s.lhs).name.text);
-    if (!lookup(key)) {
+    const PouInfo* self = b_->pou;
+    bool is_result = self && ((self->property && iequals(self->property->name.text, key)) || iequals(self->name, key));
+    if (!lookup(key) && !is_result) {
       if (PouInfo* st = b_->this_type->pou->find_method("__SET_" + key)) {
         Place self = this_place(s.loc);
         Val v = expr_for(*s.rhs, st->inputs.empty() ? nullptr : st->inputs[0]->type);

@@ -1,11 +1,75 @@
 // The standard function blocks of IEC 61131-3, written in ST and compiled with every
 // application. Timers read the scan clock through __NOW(), never the wall clock.
+#include <string>
+
 #include "codegen/compiler.hpp"
 
 namespace plcfi::st {
 
-const char* stdlib_source() {
-  return R"ST(
+namespace {
+// CTU, CTD and CTUD for one count type; the standard names the INT ones plain
+// (CTU) and the others by suffix (CTU_DINT, CTU_LINT, CTU_UDINT, CTU_ULINT).
+std::string counters(const std::string& suffix, const std::string& type, const std::string& lo, const std::string& hi) {
+  std::string text = R"ST(
+FUNCTION_BLOCK CTU@S
+VAR_INPUT CU : BOOL; R : BOOL; PV : @T; END_VAR
+VAR_OUTPUT Q : BOOL; CV : @T; END_VAR
+VAR prev : BOOL; END_VAR
+IF R THEN
+  CV := 0;
+ELSIF CU AND NOT prev AND CV < @HI THEN
+  CV := CV + 1;
+END_IF;
+prev := CU;
+Q := CV >= PV;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK CTD@S
+VAR_INPUT CD : BOOL; LD : BOOL; PV : @T; END_VAR
+VAR_OUTPUT Q : BOOL; CV : @T; END_VAR
+VAR prev : BOOL; END_VAR
+IF LD THEN
+  CV := PV;
+ELSIF CD AND NOT prev AND CV > @LO THEN
+  CV := CV - 1;
+END_IF;
+prev := CD;
+Q := CV <= 0;
+END_FUNCTION_BLOCK
+
+FUNCTION_BLOCK CTUD@S
+VAR_INPUT CU : BOOL; CD : BOOL; R : BOOL; LD : BOOL; PV : @T; END_VAR
+VAR_OUTPUT QU : BOOL; QD : BOOL; CV : @T; END_VAR
+VAR cu_prev : BOOL; cd_prev : BOOL; up : BOOL; down : BOOL; END_VAR
+up := CU AND NOT cu_prev;
+down := CD AND NOT cd_prev;
+IF R THEN
+  CV := 0;
+ELSIF LD THEN
+  CV := PV;
+ELSIF NOT (up AND down) THEN
+  IF up AND CV < @HI THEN
+    CV := CV + 1;
+  ELSIF down AND CV > @LO THEN
+    CV := CV - 1;
+  END_IF;
+END_IF;
+cu_prev := CU;
+cd_prev := CD;
+QU := CV >= PV;
+QD := CV <= 0;
+END_FUNCTION_BLOCK
+
+)ST";
+  for (auto [key, value] : {std::pair<std::string, std::string>{"@S", suffix}, {"@T", type}, {"@LO", lo}, {"@HI", hi}}) {
+    for (size_t pos = text.find(key); pos != std::string::npos; pos = text.find(key, pos + value.size()))
+      text.replace(pos, key.size(), value);
+  }
+  return text;
+}
+
+std::string build_stdlib() {
+  std::string text = R"ST(
 (* TON: Q rises when IN has been TRUE for PT; ET counts up to PT and resets with IN. *)
 FUNCTION_BLOCK TON
 VAR_INPUT IN : BOOL; PT : TIME; END_VAR
@@ -96,55 +160,6 @@ Q := NOT CLK AND M;
 M := CLK;
 END_FUNCTION_BLOCK
 
-FUNCTION_BLOCK CTU
-VAR_INPUT CU : BOOL; R : BOOL; PV : INT; END_VAR
-VAR_OUTPUT Q : BOOL; CV : INT; END_VAR
-VAR prev : BOOL; END_VAR
-IF R THEN
-  CV := 0;
-ELSIF CU AND NOT prev AND CV < 32767 THEN
-  CV := CV + 1;
-END_IF;
-prev := CU;
-Q := CV >= PV;
-END_FUNCTION_BLOCK
-
-FUNCTION_BLOCK CTD
-VAR_INPUT CD : BOOL; LD : BOOL; PV : INT; END_VAR
-VAR_OUTPUT Q : BOOL; CV : INT; END_VAR
-VAR prev : BOOL; END_VAR
-IF LD THEN
-  CV := PV;
-ELSIF CD AND NOT prev AND CV > -32768 THEN
-  CV := CV - 1;
-END_IF;
-prev := CD;
-Q := CV <= 0;
-END_FUNCTION_BLOCK
-
-FUNCTION_BLOCK CTUD
-VAR_INPUT CU : BOOL; CD : BOOL; R : BOOL; LD : BOOL; PV : INT; END_VAR
-VAR_OUTPUT QU : BOOL; QD : BOOL; CV : INT; END_VAR
-VAR cu_prev : BOOL; cd_prev : BOOL; up : BOOL; down : BOOL; END_VAR
-up := CU AND NOT cu_prev;
-down := CD AND NOT cd_prev;
-IF R THEN
-  CV := 0;
-ELSIF LD THEN
-  CV := PV;
-ELSIF NOT (up AND down) THEN
-  IF up AND CV < 32767 THEN
-    CV := CV + 1;
-  ELSIF down AND CV > -32768 THEN
-    CV := CV - 1;
-  END_IF;
-END_IF;
-cu_prev := CU;
-cd_prev := CD;
-QU := CV >= PV;
-QD := CV <= 0;
-END_FUNCTION_BLOCK
-
 (* SR: set dominant. RS: reset dominant. *)
 FUNCTION_BLOCK SR
 VAR_INPUT S1 : BOOL; R : BOOL; END_VAR
@@ -158,6 +173,18 @@ VAR_OUTPUT Q1 : BOOL; END_VAR
 Q1 := NOT R1 AND (S OR Q1);
 END_FUNCTION_BLOCK
 )ST";
+  text += counters("", "INT", "-32768", "32767");
+  text += counters("_DINT", "DINT", "-2147483648", "2147483647");
+  text += counters("_LINT", "LINT", "-9223372036854775807", "9223372036854775807");
+  text += counters("_UDINT", "UDINT", "0", "4294967295");
+  text += counters("_ULINT", "ULINT", "0", "18446744073709551615");
+  return text;
+}
+}  // namespace
+
+const char* stdlib_source() {
+  static const std::string text = build_stdlib();
+  return text.c_str();
 }
 
 }  // namespace plcfi::st

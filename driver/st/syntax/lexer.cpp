@@ -148,6 +148,7 @@ void Lexer::skip_trivia() {
         }
       }
       if (depth != 0) {
+        junk_ = true;
         error("ST002", begin, open == '(' ? "unterminated comment: '(*' has no matching '*)'"
                                           : "unterminated comment: '/*' has no matching '*/'");
         pos_ = text_.size();
@@ -156,6 +157,7 @@ void Lexer::skip_trivia() {
       const size_t begin = pos_;
       const size_t close = text_.find('}', pos_);
       if (close == std::string_view::npos) {
+        junk_ = true;
         error("ST011", begin, "unterminated pragma: '{' has no matching '}'");
         pos_ = text_.size();
       } else {
@@ -171,7 +173,15 @@ Token Lexer::next() {
   Token tok = [this]() -> Token {
     skip_trivia();
     const size_t begin = pos_;
-    if (pos_ >= text_.size()) return make(Tok::Eof, begin);
+    if (pos_ >= text_.size()) {
+      // "found end of file" points just after the last visible character, not at a line
+      // past the end that no editor shows.
+      size_t last = text_.size();
+      while (last > 0 && std::isspace(static_cast<unsigned char>(text_[last - 1]))) --last;
+      Token eof = make(Tok::Eof, begin);
+      eof.loc = eof.end = loc_at(last);
+      return eof;
+    }
     const char c = text_[pos_];
     if (is_ident_start(c)) return lex_identifier();
     if (is_digit(c)) return lex_number();
@@ -214,10 +224,13 @@ Token Lexer::next() {
     while (end < text_.size() && (static_cast<unsigned char>(text_[end]) & 0xC0) == 0x80) ++end;
     const std::string shown(text_.substr(pos_, end - pos_));
     error("ST001", begin, "unexpected character '" + shown + "'");
+    junk_ = true;
     pos_ = end;
     return next();
   }();
   prev_ = tok.kind;
+  tok.after_junk = tok.after_junk || junk_;  // (garbage recurses into next())
+  junk_ = false;
   return tok;
 }
 

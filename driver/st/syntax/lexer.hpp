@@ -36,7 +36,8 @@ class Lexer {
   DiagEngine& diags_;
   std::string_view text_;
   size_t pos_ = 0;
-  Tok prev_ = Tok::Eof;  // kind of the previous token: after '.', digits are a bit number
+  Tok prev_ = Tok::Eof;
+  bool junk_ = false;    // an error was reported for text skipped before the next token  // kind of the previous token: after '.', digits are a bit number
 };
 
 // Lexes a whole file; the last token is Tok::Eof.

@@ -168,12 +168,27 @@ class Parser {
     // One error per token: later complaints about the same spot are consequences.
     if (pos_ == last_error_pos_ && !stack) return nullptr;
     last_error_pos_ = pos_;
+    // Text the lexer skipped and reported right before this token explains the complaint.
+    if (cur().after_junk) return nullptr;
     return &diags_.error(code, loc, std::move(message));
   }
   bool expect(Tok k, const char* code, const std::string& context) {
     if (accept(k)) return true;
     error(code, missing_loc(), "expected " + std::string(tok_name(k)) + " " + context + ", found " + describe(cur()));
+    skip_misspelt_keyword();
     return false;
+  }
+  // After a missing THEN/DO/OF/TO: a name on the same line that cannot start a statement
+  // (`IF a THN x := 1;`, `FOR i := 1 UPTO 3`) is the misspelt keyword; drop it so the rest
+  // of the line parses.
+  void skip_misspelt_keyword() {
+    if (!at(Tok::Ident) || pos_ == 0 || cur().loc.line != prev().end.line) return;
+    const Tok next = la(1).kind;
+    if (next == Tok::Assign || next == Tok::LParen || next == Tok::Dot || next == Tok::LBracket ||
+        next == Tok::Caret || next == Tok::RefAssign || next == Tok::Hash || next == Tok::Semi ||
+        la(1).loc.line != cur().loc.line)
+      return;
+    advance();
   }
   std::string source_text(size_t from_tok, size_t to_tok) const {
     if (from_tok >= to_tok || to_tok > toks_.size()) return "";
@@ -928,7 +943,10 @@ StmtPtr Parser::parse_for() {
                                         describe(cur()));
     }
     s->from = parse_expr();
-    if (!accept(Tok::To)) error("ST122", missing_loc(), "expected TO in the FOR statement, found " + describe(cur()));
+    if (!accept(Tok::To)) {
+      error("ST122", missing_loc(), "expected TO in the FOR statement, found " + describe(cur()));
+      skip_misspelt_keyword();
+    }
     s->to = parse_expr();
     if (accept(Tok::By)) s->by = parse_expr();
     expect(Tok::Do, "ST108", "after the FOR header");

@@ -120,6 +120,7 @@ struct Token {
   uint32_t offset = 0;   // byte offset of the first character
   std::string_view text; // as written (points into the SourceFile)
   bool bad = false;      // malformed literal: already reported by the lexer
+  bool after_junk = false;  // skipped text before it was reported (garbage, unclosed comment)
 
   // Literal payload (IntLit, RealLit, StringLit, WStringLit, TimeLit).
   LiteralKind lit = LiteralKind::Int;
