@@ -695,7 +695,7 @@ TEST(ParserRecovery, DeclarationErrors) {
       "  f : INT;\n"
       "END_VAR\n"
       "END_PROGRAM\n");
-  EXPECT_EQ(p->errors(), (Errors{{"ST135", 3}, {"ST105", 4}, {"ST119", 5}, {"ST123", 6}}));
+  EXPECT_EQ(p->errors(), (Errors{{"ST134", 3}, {"ST105", 4}, {"ST119", 5}, {"ST123", 6}}));
   EXPECT_EQ(p->unit->pous[0]->var_blocks[0].decls.back().names[0].text, "f");
 }
 

@@ -1124,7 +1124,7 @@ bool Parser::parse_var_decl(std::vector<VarDecl>& out, VarSection section, bool 
   }
   const std::string first = decl.names.front().text;
   if (!accept(Tok::Colon)) {
-    error("ST135", missing_loc(), "expected ':' and a type after '" + first + "', found " + describe(cur()));
+    error("ST134", missing_loc(), "expected ':' and a type after '" + first + "', found " + describe(cur()));
     sync_decl();
     return false;
   }
@@ -1288,7 +1288,7 @@ void Parser::parse_type_block(std::vector<TypeDecl>& out) {
       td.name = Ident{std::string(name.text), name.loc};
       td.loc = name.loc;
       if (!accept(Tok::Colon)) {
-        error("ST135", missing_loc(), "expected ':' and a type after '" + td.name.text + "', found " + describe(cur()));
+        error("ST134", missing_loc(), "expected ':' and a type after '" + td.name.text + "', found " + describe(cur()));
         sync_decl();
         continue;
       }
@@ -1469,7 +1469,7 @@ std::unique_ptr<PropertyDecl> Parser::parse_property(bool in_interface) {
   if (accept(Tok::Colon)) {
     p->type = parse_type_spec();
   } else {
-    error("ST135", missing_loc(), "expected ':' and a type after PROPERTY '" + p->name.text + "', found " +
+    error("ST134", missing_loc(), "expected ':' and a type after PROPERTY '" + p->name.text + "', found " +
                                       describe(cur()));
     p->type = error_type(cur().loc);
   }
