@@ -9,12 +9,6 @@
 namespace plcfi::st::detail {
 
 namespace {
-std::string callee_name(const Expr& e) {
-  if (e.kind == ExprKind::Name) return static_cast<const NameExpr&>(e).name.text;
-  if (e.kind == ExprKind::Member) return static_cast<const MemberExpr&>(e).member.text;
-  return "";
-}
-
 struct BuiltinParams {
   const char* name;
   std::vector<const char*> params;

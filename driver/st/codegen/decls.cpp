@@ -178,19 +178,23 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
       uint64_t count = 1;
       bool ok = true;
       for (const auto& r : spec.dims) {
-        auto lo = r.lo ? const_int(*r.lo, file) : std::nullopt;
-        auto hi = r.hi ? const_int(*r.hi, file) : std::nullopt;
-        if (!lo || !hi) {
+        if (!r.lo || !r.hi) {
           ok = false;
           break;
         }
-        if (*hi < *lo || *lo < INT32_MIN || *hi > INT32_MAX) {
-          diags_.error("ST229", r.lo->loc, "invalid array bounds " + std::to_string(*lo) + ".." + std::to_string(*hi));
+        std::optional<int64_t> lo_opt = const_int(*r.lo, file), hi_opt = const_int(*r.hi, file);
+        if (!lo_opt || !hi_opt) {
           ok = false;
           break;
         }
-        dims.push_back({*lo, *hi});
-        count *= static_cast<uint64_t>(*hi - *lo + 1);
+        int64_t lo = *lo_opt, hi = *hi_opt;
+        if (hi < lo || lo < INT32_MIN || hi > INT32_MAX) {
+          diags_.error("ST229", r.lo->loc, "invalid array bounds " + std::to_string(lo) + ".." + std::to_string(hi));
+          ok = false;
+          break;
+        }
+        dims.push_back({lo, hi});
+        count *= static_cast<uint64_t>(hi - lo + 1);
       }
       if (!ok) break;
       if (count * el->size > (64u << 20)) {

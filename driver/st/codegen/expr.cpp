@@ -1171,9 +1171,9 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   }
   if (is_logic(e.op)) {
     if (t->is_real()) return op_error();
-    Op op = e.op == BinaryOp::And ? Op::AND_I8 : e.op == BinaryOp::Or ? Op::OR_I8 : Op::XOR_I8;
+    Op bitop = e.op == BinaryOp::And ? Op::AND_I8 : e.op == BinaryOp::Or ? Op::OR_I8 : Op::XOR_I8;
     Slot d = temp_for(t);
-    emit(int_op(op, t->storage()), {d, a, b});
+    emit(int_op(bitop, t->storage()), {d, a, b});
     def(d);
     Val v;
     v.type = t;

@@ -156,8 +156,8 @@ void Compiler::assign_stmt(const AssignStmt& s) {
   }
   if (s.lhs->kind == ExprKind::Name && b_->this_type && b_->this_type->pou) {
     std::string key = canon(static_cast<const NameExpr&>(*s.lhs).name.text);
-    const PouInfo* self = b_->pou;
-    bool is_result = self && ((self->property && iequals(self->property->name.text, key)) || iequals(self->name, key));
+    const PouInfo* cur = b_->pou;
+    bool is_result = cur && ((cur->property && iequals(cur->property->name.text, key)) || iequals(cur->name, key));
     if (!lookup(key) && !is_result) {
       if (PouInfo* st = b_->this_type->pou->find_method("__SET_" + key)) {
         Place self = this_place(s.loc);
@@ -259,19 +259,21 @@ void Compiler::case_stmt(const CaseStmt& s) {
   };
   for (size_t a = 0; a < s.arms.size(); ++a) {
     for (const auto& l : s.arms[a].labels) {
-      auto lo = l.lo ? label_value(*l.lo) : std::nullopt;
-      auto hi = l.hi ? label_value(*l.hi) : lo;
-      if (!lo || !hi) continue;
-      if (*hi < *lo) {
+      if (!l.lo) continue;
+      std::optional<int64_t> lo_opt = label_value(*l.lo);
+      std::optional<int64_t> hi_opt = l.hi ? label_value(*l.hi) : lo_opt;
+      if (!lo_opt || !hi_opt) continue;
+      int64_t lo = *lo_opt, hi = *hi_opt;
+      if (hi < lo) {
         diags_.error("ST221", l.lo->loc, "empty label range");
         continue;
       }
       for (const auto& r : ranges)
-        if (!(*hi < r.lo || *lo > r.hi)) {
-          diags_.error("ST221", l.lo->loc, "CASE label " + std::to_string(std::max(*lo, r.lo)) + " appears twice");
+        if (!(hi < r.lo || lo > r.hi)) {
+          diags_.error("ST221", l.lo->loc, "CASE label " + std::to_string(std::max(lo, r.lo)) + " appears twice");
           break;
         }
-      ranges.push_back({*lo, *hi, a});
+      ranges.push_back({lo, hi, a});
     }
   }
   std::vector<Label> arm_labels;

@@ -868,9 +868,15 @@ StmtPtr Parser::parse_if() {
       s->else_loc = advance().loc;
       s->else_body.emplace();
       parse_stmt_list(*s->else_body, false);
-      if (at(Tok::Elsif)) {
+      while (at(Tok::Elsif)) {
+        // Parsed (and kept out of the AST) so that its own errors still show.
         error("ST118", cur().loc, "ELSIF after ELSE: ELSE must be the last branch of the IF at line " +
                                       std::to_string(kw.loc.line));
+        advance();
+        IfStmt::Arm late;
+        late.cond = parse_expr();
+        expect(Tok::Then, "ST107", "after the ELSIF condition");
+        parse_stmt_list(late.body, false);
       }
     }
   }
@@ -1056,7 +1062,10 @@ VarBlock Parser::parse_var_block() {
   }
   const std::string opener(kw.text);
   for (;;) {
-    if (accept(Tok::EndVar)) break;
+    if (accept(Tok::EndVar)) {
+      accept(Tok::Semi);  // tolerated: `END_VAR;`
+      break;
+    }
     if (at(Tok::Ident)) {
       const Tok next = la(1).kind;
       const bool stmt_like = next == Tok::Assign || next == Tok::LParen || next == Tok::Caret ||

@@ -24,7 +24,6 @@ template <class T>
 void st(uint8_t* p, T v) {
   std::memcpy(p, &v, sizeof(T));
 }
-const char* cs(const uint8_t* p) { return reinterpret_cast<const char*>(p); }
 char* cs(uint8_t* p) { return reinterpret_cast<char*>(p); }
 
 // Writes [s, s+n) as the string at dst with capacity cap. Source and destination may
