@@ -669,6 +669,9 @@ TEST(ParserRecovery, MissingAndMismatchedEnds) {
   EXPECT_EQ(unit("PROGRAM p\n x := 1;\n END_IF\nEND_PROGRAM\n")->errors(), (Errors{{"ST118", 3}}));
   EXPECT_EQ(unit("PROGRAM p\n IF a THEN x := 1; END_FOR\nEND_PROGRAM\n")->errors(), (Errors{{"ST110", 2}}));
   EXPECT_EQ(unit("PROGRAM p\n ELSE x := 1;\nEND_PROGRAM\n")->errors(), (Errors{{"ST118", 2}}));
+  EXPECT_EQ(unit("PROGRAM p\n IF a THEN ; ELSE ;\n ELSIF b THEN ; END_IF\nEND_PROGRAM\n")->errors(),
+            (Errors{{"ST118", 3}}));
+  EXPECT_EQ(unit("PROGRAM p\nVAR x : INT; END_VAR;\nVAR y : INT; END_VAR\nEND_PROGRAM\n")->errors(), Errors{});
   // Both missing ends are reported.
   EXPECT_EQ(unit("PROGRAM p\n FOR i := 1 TO 2 DO\n IF a THEN\nEND_PROGRAM\n")->errors(),
             (Errors{{"ST110", 4}, {"ST112", 4}}));
