@@ -736,6 +736,16 @@ TEST(ParserRecovery, NestingTooDeep) {
   std::string deep_unary = "PROGRAM p\n x := " + std::string(5000, '-') + "1;\nEND_PROGRAM\n";
   EXPECT_EQ(unit(deep_unary)->codes(), std::vector<std::string>{"ST117"});
 
+  std::string deep_pow = "PROGRAM p\n x := ";
+  for (int i = 0; i < 5000; ++i) deep_pow += "2 ** -";
+  deep_pow += "1;\nEND_PROGRAM\n";
+  EXPECT_EQ(unit(deep_pow)->codes(), std::vector<std::string>{"ST117"});
+
+  std::string deep_refs = "PROGRAM p\nVAR x : ";
+  for (int i = 0; i < 5000; ++i) deep_refs += i % 2 ? "REF_TO " : "POINTER TO ";
+  deep_refs += "INT; END_VAR\nEND_PROGRAM\n";
+  EXPECT_EQ(unit(deep_refs)->codes(), std::vector<std::string>{"ST117"});
+
   std::string deep_calls = "PROGRAM p\n x := ";
   for (int i = 0; i < 1000; ++i) deep_calls += "f(";
   deep_calls += std::string(1000, ')') + ";\nEND_PROGRAM\n";

@@ -443,9 +443,11 @@ ExprPtr Parser::parse_unary() {
   if (!at(Tok::Minus) && !at(Tok::Plus) && !at(Tok::Not)) return parse_power();
   DepthGuard guard(*this);
   if (guard.exceeded) {
+    // Skip the rest of the operand without recursing (`2 ** -2 ** -2 ...` nests through here).
+    const SourceLoc loc = cur().loc;
     report_too_deep();
-    while (at(Tok::Minus) || at(Tok::Plus) || at(Tok::Not)) advance();
-    return parse_power();
+    skip_nested();
+    return error_expr(loc);
   }
   const Token& t = advance();
   auto u = std::make_unique<UnaryExpr>(t.loc);
