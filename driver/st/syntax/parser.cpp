@@ -296,6 +296,7 @@ class Parser {
   VarBlock parse_var_block();
   bool parse_var_decl(std::vector<VarDecl>& out, VarSection section, bool path_names);
   TypeSpecPtr parse_type_spec();
+  TypeSpecPtr parse_return_type();
   void parse_enum_values(TypeSpec& spec);
   void parse_type_block(std::vector<TypeDecl>& out);
   ConfigDecl parse_configuration();
@@ -1221,7 +1222,8 @@ TypeSpecPtr Parser::parse_type_spec() {
   if (at(Tok::LParen)) {
     spec->kind = TypeSpecKind::Enum;
     parse_enum_values(*spec);
-    if (at(Tok::Ident)) {
+    // `(A, B) INT`; but a name followed by ':' starts the next declaration (missing ';').
+    if (at(Tok::Ident) && la(1).kind != Tok::Colon && la(1).kind != Tok::Comma) {
       const Token& b = advance();
       spec->element = std::make_unique<TypeSpec>();
       spec->element->loc = b.loc;
@@ -1269,6 +1271,16 @@ TypeSpecPtr Parser::parse_type_spec() {
     expect(Tok::RParen, "ST116", "to close the subrange");
   }
   return spec;
+}
+
+// return_type := type_spec   (after FUNCTION name ':' / METHOD name ':')
+TypeSpecPtr Parser::parse_return_type() {
+  // `FUNCTION F :` with the type forgotten: do not take the first statement's target as the type.
+  if (at(Tok::Ident) && (la(1).kind == Tok::Assign || la(1).kind == Tok::RefAssign)) {
+    error("ST119", missing_loc(), "expected the return type after ':', found " + describe(cur()));
+    return error_type(cur().loc);
+  }
+  return parse_type_spec();
 }
 
 // enum_values := '(' enum_value {',' enum_value} ')'; enum_value := name [':=' expr]
@@ -1422,7 +1434,7 @@ PouPtr Parser::parse_pou() {
   FrameGuard frame(*this, {end, Tok::Eof, Tok::Eof}, false);
   if (pou->kind == PouKind::FunctionBlock) parse_modifiers(&pou->access, &pou->is_abstract, &pou->is_final);
   expect_ident(&pou->name, "ST100", std::string("a name after ") + std::string(kw.text));
-  if (pou->kind == PouKind::Function && accept(Tok::Colon)) pou->return_type = parse_type_spec();
+  if (pou->kind == PouKind::Function && accept(Tok::Colon)) pou->return_type = parse_return_type();
   if (pou->kind == PouKind::FunctionBlock) {
     if (accept(Tok::Extends)) {
       Ident base;
@@ -1460,7 +1472,7 @@ PouPtr Parser::parse_method(bool in_interface) {
   FrameGuard frame(*this, {Tok::EndMethod, Tok::Eof, Tok::Eof}, false);
   parse_modifiers(&m->access, &m->is_abstract, &m->is_final);
   expect_ident(&m->name, "ST100", "a method name after METHOD");
-  if (accept(Tok::Colon)) m->return_type = parse_type_spec();
+  if (accept(Tok::Colon)) m->return_type = parse_return_type();
   accept(Tok::Semi);
   parse_pou_body(*m, false);
   expect_unit_end(Tok::EndMethod, "METHOD '" + m->name.text + "'", kw.loc, &m->end_loc);
