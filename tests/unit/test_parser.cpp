@@ -702,6 +702,29 @@ TEST(ParserRecovery, DeclarationErrors) {
   EXPECT_EQ(p->unit->pous[0]->var_blocks[0].decls.back().names[0].text, "f");
 }
 
+TEST(ParserRecovery, ForgottenPiecesDoNotSwallowTheNextLine) {
+  EXPECT_EQ(unit("FUNCTION F :\n  F := 1;\nEND_FUNCTION\n")->errors(), (Errors{{"ST119", 1}}));
+  EXPECT_EQ(unit("TYPE\n  E : (A, B)\n  S : INT;\nEND_TYPE\n")->errors(), (Errors{{"ST105", 2}}));
+  EXPECT_EQ(unit("PROGRAM p\n  IF a THN x := 1; END_IF\nEND_PROGRAM\n")->errors(), (Errors{{"ST107", 2}}));
+  EXPECT_EQ(unit("PROGRAM p\n  x := 1 ? 2;\nEND_PROGRAM\n")->codes(), std::vector<std::string>{"ST001"});
+  EXPECT_EQ(unit("PROGRAM p\n  x := 1;\n  (* open\nEND_PROGRAM\n")->codes(), std::vector<std::string>{"ST002"});
+  EXPECT_EQ(unit("PROGRAM p\n  s := 'open;\n  x := 1;\nEND_PROGRAM\n")->codes(), std::vector<std::string>{"ST003"});
+}
+
+TEST(ParserRecovery, DiagnosticsComeInSourceOrder) {
+  auto p = unit("PROGRAM p\n  x := ;\n  y := 8#9;\n  z := ;\nEND_PROGRAM\n");
+  EXPECT_EQ(p->errors(), (Errors{{"ST115", 2}, {"ST006", 3}, {"ST115", 4}}));
+}
+
+TEST(ParserDecl, VarConfigPaths) {
+  auto p = unit("CONFIGURATION C\nVAR_CONFIG\n  R.Inst.sensor AT %IX1.0 : BOOL;\nEND_VAR\nEND_CONFIGURATION\n");
+  ASSERT_FALSE(p->diags.has_errors()) << p->diags.render_all();
+  const auto& decl = p->unit->configs[0].globals[0].decls[0];
+  EXPECT_EQ(decl.section, VarSection::Config);
+  EXPECT_EQ(decl.names[0].text, "R.Inst.sensor");
+  EXPECT_EQ(decl.location->text, "%IX1.0");
+}
+
 TEST(ParserRecovery, GarbageAtTopLevelIsOneError) {
   auto p = unit("garbage here 1 2 3 ;\nPROGRAM p END_PROGRAM\n+ + +\n");
   EXPECT_EQ(p->errors(), (Errors{{"ST101", 1}, {"ST101", 3}}));
