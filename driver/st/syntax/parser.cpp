@@ -1339,6 +1339,8 @@ void Parser::parse_type_block(std::vector<TypeDecl>& out) {
   }
 }
 
+// modifiers := {PUBLIC | PRIVATE | PROTECTED | INTERNAL | ABSTRACT | FINAL | OVERRIDE}
+// (contextual words: only taken as modifiers when a name follows)
 void Parser::parse_modifiers(Access* access, bool* is_abstract, bool* is_final) {
   while (at(Tok::Ident) && la(1).kind == Tok::Ident) {
     const std::string w = canon(cur().text);
@@ -1579,6 +1581,7 @@ ProgramInstDecl Parser::parse_program_inst() {
   return p;
 }
 
+// resource_body := {var_block | task | program_inst}
 void Parser::parse_resource_body(ResourceDecl& res, Tok end) {
   for (;;) {
     const size_t before = pos_;
@@ -1701,6 +1704,7 @@ void Parser::parse_top_level(CompilationUnit& unit) {
   }
 }
 
+// unit := {top_level}
 std::unique_ptr<CompilationUnit> Parser::parse_unit() {
   auto unit = std::make_unique<CompilationUnit>();
   unit->file = file_;
