@@ -286,6 +286,16 @@ TEST(Lexer, TypedLiteralPiecesAreSeparateTokens) {
   EXPECT_EQ(l->toks[2].int_value, 255u);
 }
 
+TEST(Lexer, ByteOrderMarkAndCrLf) {
+  auto l = lex("\xEF\xBB\xBFPROGRAM p\r\n  x := 'a';\r\nEND_PROGRAM\r\n");
+  EXPECT_FALSE(l->diags.has_errors()) << l->diags.render_all();
+  ASSERT_EQ(l->toks.size(), 8u);
+  EXPECT_EQ(l->toks[0].kind, Tok::Program);
+  EXPECT_EQ(l->toks[0].loc.col, 4u);  // columns count bytes
+  EXPECT_EQ(l->toks[4].str_value, "a");
+  EXPECT_EQ(l->toks[6].loc.line, 3u);
+}
+
 TEST(Lexer, GarbageIsReportedOnceAndSkipped) {
   auto l = lex("a @ b ? c \xC3\xA9 d");
   EXPECT_EQ(codes(*l), (std::vector<std::string>{"ST001", "ST001", "ST001"}));

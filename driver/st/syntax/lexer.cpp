@@ -96,7 +96,10 @@ Tok keyword_kind(std::string_view word) {
 }
 
 Lexer::Lexer(const SourceManager& sm, uint32_t file, DiagEngine& diags)
-    : src_(sm.file(file)), file_(file), diags_(diags), text_(src_.text) {}
+    : src_(sm.file(file)), file_(file), diags_(diags), text_(src_.text) {
+  // Editors on Windows (and CODESYS exports) often start files with a UTF-8 byte order mark.
+  if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;
+}
 
 SourceLoc Lexer::loc_at(size_t offset) const {
   const auto& starts = src_.line_starts;
