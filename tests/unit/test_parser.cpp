@@ -76,6 +76,8 @@ std::string var_type(const std::string& decl) {
   return dump(*d.type) + (d.init ? " := " + dump(*d.init) : std::string());
 }
 
+using Errors = std::vector<std::pair<std::string, uint32_t>>;
+
 // ------------------------------------------------------------------ expressions
 
 TEST(ParserExpr, Precedence) {
@@ -109,6 +111,8 @@ TEST(ParserExpr, PostfixChains) {
   EXPECT_EQ(expr("SUPER^.Init(1, 2)"), "(call (. (^ SUPER) Init) 1 2)");
   EXPECT_EQ(expr("obj.method(1).x"), "(. (call (. obj method) 1) x)");
   EXPECT_EQ(expr("p^^"), "(^ (^ p))");
+  EXPECT_EQ(expr("fb.Method.Type"), "(. (. fb Method) Type)");
+  EXPECT_EQ(unit("PROGRAM p\n  x := fb.\nEND_PROGRAM\n")->errors(), (Errors{{"ST133", 2}}));
 }
 
 TEST(ParserExpr, CallArguments) {
@@ -625,8 +629,6 @@ TEST(ParserTestFile, MockIsAnOrdinaryNameOutsideTests) {
 }
 
 // ------------------------------------------------------------------ errors and recovery
-
-using Errors = std::vector<std::pair<std::string, uint32_t>>;
 
 TEST(ParserRecovery, ThreeSeparateErrors) {
   auto p = unit(

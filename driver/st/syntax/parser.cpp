@@ -479,8 +479,13 @@ ExprPtr Parser::parse_postfix() {
   for (;;) {
     if (at(Tok::Dot)) {
       advance();
-      // Keywords are fine as member names after '.' (fb.METHOD, s.TYPE).
-      if (at(Tok::Ident) || (cur().kind > Tok::Ge && cur().kind < Tok::Count)) {
+      // Keywords are fine as member names after '.' (fb.METHOD, s.TYPE), except block words,
+      // which more likely mean the member name is missing.
+      const Tok k = cur().kind;
+      const bool keyword_member = k > Tok::Ge && k < Tok::Count && cur().loc.line == prev().end.line &&
+                                  !is_unit_end(k) && !is_strayable(k) && !is_stmt_keyword(k) &&
+                                  k != Tok::To && k != Tok::By;
+      if (at(Tok::Ident) || keyword_member) {
         const Token& t = advance();
         auto m = std::make_unique<MemberExpr>(e->loc);
         m->base = std::move(e);
