@@ -249,6 +249,9 @@ TEST(Lexer, DateErrors) {
   EXPECT_EQ(first_code("TOD#12:61:00"), "ST009");
   EXPECT_EQ(first_code("DT#2024-01-01"), "ST009");
   EXPECT_EQ(first_code("DT#2024-01-01-12:00:00x"), "ST009");
+  EXPECT_EQ(first_code("D#9999-12-31"), "ST009");
+  EXPECT_EQ(first_code("DT#1000-01-01-00:00:00"), "ST009");
+  EXPECT_EQ(one("D#1969-12-31").time_ns, -86400 * kSec);
 }
 
 TEST(Lexer, DirectAddresses) {

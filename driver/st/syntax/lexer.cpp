@@ -588,6 +588,12 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
 
   int64_t value = 0;
   LiteralKind lit = LiteralKind::Time;
+  // Nanoseconds since the epoch in 64 bits reach from 1677 to 2262.
+  auto date_ns = [&](int64_t days, int64_t tod) {
+    if (__builtin_mul_overflow(days, kNsPerDay, &value) || __builtin_add_overflow(value, tod, &value))
+      return fail(begin, "date out of range (representable: 1677-09-22 to 2262-04-11)");
+    return true;
+  };
   if (kind == TimePrefix::Duration) {
     bool negative = false;
     if (peek() == '-' || peek() == '+') {
@@ -645,7 +651,7 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
     lit = LiteralKind::Time;
   } else if (kind == TimePrefix::Date) {
     int64_t days = 0;
-    if (read_date(&days)) value = days * kNsPerDay;
+    if (read_date(&days)) date_ns(days, 0);
     lit = LiteralKind::Date;
   } else if (kind == TimePrefix::TimeOfDay) {
     read_tod(&value);
@@ -653,7 +659,7 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
   } else {
     int64_t days = 0, tod = 0;
     if (read_date(&days) && expect_char('-', "between date and time (YYYY-MM-DD-hh:mm:ss)") && read_tod(&tod))
-      value = days * kNsPerDay + tod;
+      date_ns(days, tod);
     lit = LiteralKind::DateTime;
   }
   if (ok && pos_ < text_.size() && (is_ident_char(text_[pos_]) || text_[pos_] == '.' || text_[pos_] == ':'))
