@@ -433,9 +433,9 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   for (size_t i = 0; i < sm_.size(); ++i) app_->file_paths.push_back(sm_.file(static_cast<uint32_t>(i)).path);
 
   alloc(16, 16);  // address 0 stays invalid: it is the null reference
-  app_->image_i = {'I', alloc(opt_.image_size_i, 8), opt_.image_size_i};
-  app_->image_q = {'Q', alloc(opt_.image_size_q, 8), opt_.image_size_q};
-  app_->image_m = {'M', alloc(opt_.image_size_m, 8), opt_.image_size_m};
+  app_->image_i = {'I', alloc(opt_.image_size_i, 8), opt_.image_size_i, 0};
+  app_->image_q = {'Q', alloc(opt_.image_size_q, 8), opt_.image_size_q, 0};
+  app_->image_m = {'M', alloc(opt_.image_size_m, 8), opt_.image_size_m, 0};
 
   std::vector<const CompilationUnit*> all = units;
   for (const auto* t : tests) all.push_back(&t->decls);

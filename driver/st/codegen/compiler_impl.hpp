@@ -206,6 +206,9 @@ class Compiler {
   Slot convert(Slot s, const Type* from, const Type* to);
   Slot addr_of(const Place& p, SourceLoc loc);
   Val cond(const Expr& e);
+  // Emits "jump to target when the condition is false (or true)"; a comparison that was
+  // just computed into a temporary becomes one fused compare-and-jump instruction.
+  void branch_on(const Val& c, SourceLoc loc, Label target, bool when_true);
   const Symbol* lookup(const std::string& canon_name) const;
   Val bad() {
     Val v;

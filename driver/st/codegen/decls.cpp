@@ -694,6 +694,8 @@ bool Compiler::locate(const DirectAddrExpr& a, const Type* t, uint32_t* addr, ui
     }
   }
   *addr = area->addr + static_cast<uint32_t>(byte);
+  auto* used = const_cast<ImageArea*>(area);
+  used->used = std::max<uint32_t>(used->used, static_cast<uint32_t>(byte + unit));
   return true;
 }
 

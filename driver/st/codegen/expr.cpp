@@ -686,6 +686,11 @@ Slot Compiler::convert(Slot s, const Type* from, const Type* to) {
   if (!from || !to || from == to) return s;
   Storage a = from->storage(), b = to->storage();
   if (a == b || a == Storage::Block || b == Storage::Block) return s;
+  // Between integers of one width a conversion only reinterprets the bits (two's
+  // complement), so the value can stay where it is.
+  auto is_int = [](Storage x) { return x != Storage::F32 && x != Storage::F64; };
+  static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8, 4, 8};
+  if (is_int(a) && is_int(b) && kWidth[storage_index(a)] == kWidth[storage_index(b)]) return s;
   Slot t = temp_for(to);
   emit(cvt_op(a, b), {t, s});
   def(t);

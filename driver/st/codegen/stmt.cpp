@@ -14,6 +14,56 @@ uint32_t Compiler::branch(SourceLoc loc, const char* kind) {
   return id;
 }
 
+void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_true) {
+  Slot cs = to_slot(c, elem(TypeKind::Bool), loc);
+  // Peephole: "CMP t, a, b; JMPF target, t" -> "J<inverse> target, a, b".
+  auto& code = b_->code;
+  uint32_t at = b_->last_instr;
+  if (!c.is_const && b_->last_def_pos == at && b_->last_label_pos <= at && b_->last_def_operand == 1 &&
+      b_->last_def.kind == cs.kind && b_->last_def.off == cs.off && cs.kind == SK::Temp) {
+    uint32_t op = code[at];
+    constexpr uint32_t stride = static_cast<uint32_t>(Op::ADD_I16) - static_cast<uint32_t>(Op::ADD_I8);
+    uint32_t base_i8 = static_cast<uint32_t>(Op::ADD_I8);
+    if (op >= base_i8 && op < base_i8 + 10 * stride) {
+      uint32_t type_idx = (op - base_i8) / stride;
+      auto in_block = static_cast<Op>(op - type_idx * stride);
+      // The jump we need: taken when the comparison's outcome equals when_true.
+      struct Map {
+        Op cmp;
+        Op jtrue;  // jump if the comparison holds
+        bool jtrue_swap;
+        Op jfalse;  // jump if it does not
+        bool jfalse_swap;
+      };
+      static const Map kMap[] = {
+          {Op::LT_I8, Op::JLT_I8, false, Op::JGE_I8, false}, {Op::GE_I8, Op::JGE_I8, false, Op::JLT_I8, false},
+          {Op::GT_I8, Op::JLT_I8, true, Op::JGE_I8, true},   {Op::LE_I8, Op::JGE_I8, true, Op::JLT_I8, true},
+          {Op::EQ_I8, Op::JEQ_I8, false, Op::JNE_I8, false}, {Op::NE_I8, Op::JNE_I8, false, Op::JEQ_I8, false},
+      };
+      for (const auto& m : kMap) {
+        if (in_block != m.cmp) continue;
+        // Floating-point compares are not inverted (NaN makes a < b and a >= b both false).
+        bool is_float = type_idx >= 8;
+        if (is_float && !when_true) break;
+        Arg a(code[at + 2]), b2(code[at + 3]);
+        for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
+          if (it->first == at + 2) a = Arg(Slot{code[at + 2], it->second});
+          if (it->first == at + 3) b2 = Arg(Slot{code[at + 3], it->second});
+          if (it->first >= at) it = b_->slot_fix.erase(it);
+          else ++it;
+        }
+        code.resize(at);
+        Op j = when_true ? m.jtrue : m.jfalse;
+        bool swap = when_true ? m.jtrue_swap : m.jfalse_swap;
+        emit(static_cast<Op>(static_cast<uint32_t>(j) + type_idx * stride), {Arg::target(target.id), swap ? b2 : a, swap ? a : b2});
+        b_->last_def_pos = UINT32_MAX;
+        return;
+      }
+    }
+  }
+  emit(when_true ? Op::JMPT : Op::JMPF, {Arg::target(target.id), cs});
+}
+
 void Compiler::stmts(const StmtList& list) {
   bool dead = false;
   for (const auto& s : list) {
@@ -208,10 +258,7 @@ void Compiler::if_stmt(const IfStmt& s) {
     if (opt_.warnings && c.ok && c.is_const && !(b_->pou && b_->pou->is_stdlib))
       diags_.warning("ST404", arm.cond->loc, std::string("condition is always ") + (c.c.i ? "TRUE" : "FALSE"));
     Label next = new_label();
-    if (c.ok) {
-      Slot cs = to_slot(c, elem(TypeKind::Bool), arm.cond->loc);
-      emit(Op::JMPF, {Arg::target(next.id), cs});
-    }
+    if (c.ok) branch_on(c, arm.cond->loc, next, false);
     b_->temp_top = saved;
     branch(arm.loc, i == 0 ? "IF" : "ELSIF");
     stmts(arm.body);
@@ -400,7 +447,7 @@ void Compiler::while_stmt(const WhileStmt& s) {
   bind(top);
   uint32_t saved = b_->temp_top;
   Val c = cond(*s.cond);
-  if (c.ok) emit(Op::JMPF, {Arg::target(exit.id), to_slot(c, elem(TypeKind::Bool), s.cond->loc)});
+  if (c.ok) branch_on(c, s.cond->loc, exit, false);
   b_->temp_top = saved;
   b_->loops.push_back({exit, top});
   branch(s.loc, "WHILE");
@@ -420,7 +467,7 @@ void Compiler::repeat_stmt(const RepeatStmt& s) {
   bind(cont);
   if (s.until) {
     Val c = cond(*s.until);
-    if (c.ok) emit(Op::JMPT, {Arg::target(exit.id), to_slot(c, elem(TypeKind::Bool), s.until->loc)});
+    if (c.ok) branch_on(c, s.until->loc, exit, true);
   }
   emit(Op::JMPB, {Arg::target(top.id)});
   bind(exit);

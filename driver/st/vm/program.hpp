@@ -131,6 +131,7 @@ struct ImageArea {
   char area;
   uint32_t addr;
   uint32_t size;
+  uint32_t used = 0;  // bytes from the start that located variables or direct addresses touch
 };
 
 class Application {

@@ -1,0 +1,30 @@
+// Signal traces of a run: VCD (IEEE 1364 value change dump, change-only, readable by
+// GTKWave) and CSV (one row per sample). Values are read through variable handles.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine.hpp"
+
+namespace plcfi::report {
+
+class TraceWriter {
+ public:
+  virtual ~TraceWriter() = default;
+  // Records the values of the watched variables at time t (ns).
+  virtual void sample(int64_t t_ns, const st::Machine& m) = 0;
+  // Flushes and closes; returns false (err) on an I/O error.
+  virtual bool close(std::string* err) = 0;
+};
+
+// Opens `path` for a VCD trace of `vars`. Fails for unwritable files and for variables
+// VCD cannot represent (strings, arrays, structures: name their elements instead).
+std::unique_ptr<TraceWriter> open_vcd(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err);
+// CSV with a header `time,<path>,...`; time in seconds; BOOL as 0/1.
+std::unique_ptr<TraceWriter> open_csv(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err);
+
+}  // namespace plcfi::report

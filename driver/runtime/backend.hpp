@@ -1,0 +1,29 @@
+// IoBackend: where the I/O image comes from and goes to (a plant model, Modbus devices,
+// GPIO lines). The runtime owns the loop; a backend only exchanges image bytes.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace plcfi::rt {
+
+// Contract: called from the scan thread only. read() fills the input area buffer as the
+// devices deliver it; write() sends the output area buffer. Neither may block beyond the
+// cycle's deadline. On failure they return false and fill last_error(); the runtime keeps
+// the last good inputs. `dt_ns` is the time that passes until the next read (the base
+// tick): a simulated plant advances its physics by that much in write().
+class IoBackend {
+ public:
+  virtual ~IoBackend() = default;
+  virtual const std::string& name() const = 0;
+  // Bytes of the %I / %Q areas this backend reads or writes (from the area start).
+  virtual uint32_t input_extent() const = 0;
+  virtual uint32_t output_extent() const = 0;
+  virtual bool read(uint8_t* inputs, int64_t now_ns) = 0;
+  virtual bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) = 0;
+  // Back to the initial state (a simulated plant resets its physics; real I/O: nothing).
+  virtual void reset(uint64_t seed) = 0;
+  virtual const std::string& last_error() const = 0;
+};
+
+}  // namespace plcfi::rt

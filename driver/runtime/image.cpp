@@ -1,0 +1,87 @@
+// Image locations and overlays.
+#include "image.hpp"
+
+#include <cstring>
+
+#include "engine.hpp"
+
+namespace plcfi::rt {
+
+int64_t ImageRef::get(const uint8_t* base) const {
+  const uint8_t* p = base + offset;
+  if (is_bit) return (*p >> bit) & 1u;
+  switch (size) {
+    case 1: return type && type->is_signed() ? static_cast<int8_t>(*p) : *p;
+    case 2: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return type && type->is_signed() ? static_cast<int16_t>(v) : v;
+    }
+    case 4: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return type && type->is_signed() ? static_cast<int32_t>(v) : v;
+    }
+    default: {
+      int64_t v;
+      std::memcpy(&v, p, 8);
+      return v;
+    }
+  }
+}
+
+void ImageRef::set(uint8_t* base, int64_t v) const {
+  uint8_t* p = base + offset;
+  if (is_bit) {
+    auto m = static_cast<uint8_t>(1u << bit);
+    *p = static_cast<uint8_t>(v ? (*p | m) : (*p & ~m));
+    return;
+  }
+  switch (size) {
+    case 1: *p = static_cast<uint8_t>(v); break;
+    case 2: {
+      auto x = static_cast<uint16_t>(v);
+      std::memcpy(p, &x, 2);
+      break;
+    }
+    case 4: {
+      auto x = static_cast<uint32_t>(v);
+      std::memcpy(p, &x, 4);
+      break;
+    }
+    default: std::memcpy(p, &v, 8); break;
+  }
+}
+
+bool parse_image_ref(const st::Application& app, const std::string& text, ImageRef* ref, std::string* err) {
+  auto h = st::resolve(app, text, err);
+  if (!h) return false;
+  const st::ImageArea* areas[] = {&app.image_i, &app.image_q};
+  for (const st::ImageArea* a : areas) {
+    if (h->addr >= a->addr && h->addr + (h->is_bit ? 1 : h->type->size) <= a->addr + a->size) {
+      ref->area = a->area;
+      ref->offset = h->addr - a->addr;
+      ref->is_bit = h->is_bit;
+      ref->bit = h->bit;
+      ref->size = static_cast<uint8_t>(h->is_bit ? 1 : h->type->size);
+      ref->type = h->type;
+      ref->text = text;
+      if (!h->is_bit && !h->type->is_elementary()) {
+        *err = "'" + text + "' is not an elementary value in the I/O image";
+        return false;
+      }
+      return true;
+    }
+  }
+  *err = "'" + text + "' is not in the %I or %Q image";
+  return false;
+}
+
+std::string ForceRule::describe() const { return "force " + ref_.text + " := " + std::to_string(value_); }
+
+void Overlay::apply(uint8_t* dst, const uint8_t* src, size_t n, int64_t now_ns) const {
+  std::memcpy(dst, src, n);
+  for (const auto& r : rules_) r->apply(dst, src, now_ns);
+}
+
+}  // namespace plcfi::rt

@@ -1,0 +1,98 @@
+// Scan cycle implementation.
+#include "runtime.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "engine.hpp"
+
+namespace plcfi::rt {
+
+Runtime::Runtime(const st::Application& app, Schedule schedule, IoBackend* backend)
+    : app_(&app), schedule_(std::move(schedule)), backend_(backend), machine_(app) {
+  raw_in_.assign(app.image_i.size, 0);
+  out_.assign(app.image_q.size, 0);
+}
+
+uint32_t Runtime::in_extent() const {
+  uint32_t e = std::max(app_->image_i.used, in_overlay_.extent());
+  if (backend_) e = std::max(e, backend_->input_extent());
+  return std::min(e, app_->image_i.size);
+}
+
+uint32_t Runtime::out_extent() const {
+  uint32_t e = std::max(app_->image_q.used, out_overlay_.extent());
+  if (backend_) e = std::max(e, backend_->output_extent());
+  return std::min(e, app_->image_q.size);
+}
+
+void Runtime::restart(uint64_t seed, bool warm) {
+  if (warm) machine_.warm_restart();
+  else machine_.cold_restart();
+  std::fill(raw_in_.begin(), raw_in_.end(), 0);
+  std::fill(out_.begin(), out_.end(), 0);
+  now_ns_ = 0;
+  scans_ = 0;
+  stopped_ = false;
+  stop_reason_.clear();
+  machine_.set_now(0);
+  if (backend_) backend_->reset(seed);
+}
+
+void Runtime::cold_restart(uint64_t seed) { restart(seed, false); }
+void Runtime::warm_restart(uint64_t seed) { restart(seed, true); }
+
+void Runtime::remove_hooks(ScanHooks* h) { hooks_.erase(std::remove(hooks_.begin(), hooks_.end(), h), hooks_.end()); }
+
+void Runtime::reapply_input_overlay() {
+  in_overlay_.apply(machine_.mem() + app_->image_i.addr, raw_in_.data(), in_extent(), now_ns_);
+}
+
+void Runtime::write_safe_outputs() {
+  std::fill(out_.begin(), out_.end(), 0);
+  std::memset(machine_.mem() + app_->image_q.addr, 0, app_->image_q.size);
+  if (backend_) backend_->write(out_.data(), now_ns_, 0);
+}
+
+void Runtime::stop(const std::string& reason) {
+  stopped_ = true;
+  stop_reason_ = reason;
+  write_safe_outputs();
+}
+
+ScanStatus Runtime::scan() {
+  const int64_t tick = schedule_.tick_ns();
+  ScanStatus status = ScanStatus::Ok;
+  uint8_t* mem = machine_.mem();
+  if (backend_ && !backend_->read(raw_in_.data(), now_ns_)) status = ScanStatus::IoError;
+  in_overlay_.apply(mem + app_->image_i.addr, raw_in_.data(), in_extent(), now_ns_);
+  machine_.set_now(now_ns_);
+  machine_.clear_taken();
+  for (ScanHooks* h : hooks_) h->before_scan(*this);
+  if (!stopped_) {
+    schedule_.for_each_due(scans_, [&](const ScheduledTask& t) {
+      for (size_t pi : t.programs) {
+        if (stopped_) return;
+        const auto& inst = app_->programs[pi];
+        if (!machine_.call(inst.pou->entry, inst.addr)) {
+          stopped_ = true;
+          stop_reason_ = st::describe_trap(*app_, machine_.trap()) + " (program " + inst.name + ")";
+          status = ScanStatus::Trapped;
+        }
+      }
+    });
+  } else if (status == ScanStatus::Ok) {
+    status = ScanStatus::Stopped;
+  }
+  machine_.merge_coverage();
+  for (ScanHooks* h : hooks_) h->after_scan(*this);
+  if (stopped_) std::memset(mem + app_->image_q.addr, 0, app_->image_q.size);  // safe state
+  out_overlay_.apply(out_.data(), mem + app_->image_q.addr, out_extent(), now_ns_);
+  if (backend_ && !backend_->write(out_.data(), now_ns_, tick) && status == ScanStatus::Ok) status = ScanStatus::IoError;
+  for (ScanHooks* h : hooks_) h->end_of_scan(*this);
+  ++scans_;
+  now_ns_ += tick;
+  return status;
+}
+
+}  // namespace plcfi::rt

@@ -1,0 +1,95 @@
+// The scan cycle: backend read -> input overlay -> before-scan hooks -> the tasks due at
+// this tick -> after-scan hooks -> output overlay -> backend write. Runs in virtual time
+// (one base tick per scan) unless a real-time clock paces it from outside.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "backend.hpp"
+#include "image.hpp"
+#include "schedule.hpp"
+#include "vm/vm.hpp"
+
+namespace plcfi::rt {
+
+class Runtime;
+
+// Plug-in points of the scan (tracer, monitors, the fault-injection driver). Called from
+// the scan thread; must not block.
+class ScanHooks {
+ public:
+  virtual ~ScanHooks() = default;
+  // After the inputs reached the program's image, before any task runs.
+  virtual void before_scan(Runtime& rt) {}
+  // After the tasks ran, before the outputs go through the output overlay.
+  virtual void after_scan(Runtime& rt) {}
+  // After the output overlay and the backend write (what reached the plant is final).
+  virtual void end_of_scan(Runtime& rt) {}
+};
+
+enum class ScanStatus { Ok, Trapped, Stopped, IoError };
+
+class Runtime {
+ public:
+  Runtime(const st::Application& app, Schedule schedule, IoBackend* backend);
+
+  // Cold restart: every variable to its initial value, image cleared, clock to zero,
+  // backend reset (a simulated plant goes back to its initial state) with this seed.
+  void cold_restart(uint64_t seed);
+  // Warm restart: like cold, but RETAIN variables keep their values.
+  void warm_restart(uint64_t seed);
+
+  // One base tick. After a trap the program stays stopped (outputs in the safe state)
+  // until a restart; later scans only exchange I/O.
+  ScanStatus scan();
+
+  void add_hooks(ScanHooks* h) { hooks_.push_back(h); }
+  void remove_hooks(ScanHooks* h);
+
+  Overlay& input_overlay() { return in_overlay_; }
+  // Re-applies the input overlay within the current scan (a before-scan hook that just
+  // injected a sensor fault wants the program to see it in this very scan).
+  void reapply_input_overlay();
+  Overlay& output_overlay() { return out_overlay_; }
+  // Inputs as the backend delivered them / outputs as they reached the backend.
+  const uint8_t* raw_inputs() const { return raw_in_.data(); }
+  const uint8_t* delivered_outputs() const { return out_.data(); }
+  uint8_t* raw_inputs_mut() { return raw_in_.data(); }
+
+  st::Machine& machine() { return machine_; }
+  const st::Application& app() const { return *app_; }
+  const Schedule& schedule() const { return schedule_; }
+  IoBackend* backend() const { return backend_; }
+  int64_t now() const { return now_ns_; }
+  uint64_t scan_count() const { return scans_; }
+  bool stopped() const { return stopped_; }
+  const std::string& stop_reason() const { return stop_reason_; }
+  const st::Trap& trap() const { return machine_.trap(); }
+
+  // All outputs to the safe state (zero: valves off, setpoints 0) and sent to the backend.
+  void write_safe_outputs();
+  // Stops the program (e.g. a watchdog of the caller); outputs go to the safe state.
+  void stop(const std::string& reason);
+
+ private:
+  void restart(uint64_t seed, bool warm);
+  uint32_t in_extent() const;
+  uint32_t out_extent() const;
+
+  const st::Application* app_;
+  Schedule schedule_;
+  IoBackend* backend_;
+  st::Machine machine_;
+  std::vector<ScanHooks*> hooks_;
+  Overlay in_overlay_, out_overlay_;
+  std::vector<uint8_t> raw_in_, out_;
+  int64_t now_ns_ = 0;
+  uint64_t scans_ = 0;
+  bool stopped_ = false;
+  std::string stop_reason_;
+};
+
+}  // namespace plcfi::rt

@@ -1,0 +1,63 @@
+// The Plant interface: a machine model that stands in for the real process in virtual
+// time. Physics only: no knowledge of ST, images or faults. The runtime binds each
+// signal to an I/O image address and exchanges values once per scan.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace plcfi::plant {
+
+enum class Direction : uint8_t {
+  ToPlant,    // actuator: written by the PLC program (%Q), read by the plant
+  FromPlant,  // sensor: written by the plant, read by the PLC program (%I)
+};
+
+enum class SignalKind : uint8_t {
+  Bool,    // 0 or 1, bound to a bit (%IX/%QX)
+  Analog,  // 16-bit signed register value (%IW/%QW), engineering units of the plant
+};
+
+struct SignalInfo {
+  std::string name;         // e.g. "StampLowered"
+  Direction dir;
+  SignalKind kind;
+  std::string address;      // default image binding, e.g. "%IX0.4", "%QW2"
+  std::string description;  // one line for humans (reports, --help)
+};
+
+// Contract: single-threaded. reset() before the first step(). step() must not allocate
+// and must be deterministic for a given seed and sequence of actuator values.
+class Plant {
+ public:
+  virtual ~Plant() = default;
+
+  virtual const std::string& name() const = 0;
+  // All signals; the index of a signal in this vector is its index in step()'s arrays.
+  virtual const std::vector<SignalInfo>& signals() const = 0;
+
+  // Back to the initial physical state; the seed drives the random variation.
+  virtual void reset(uint64_t seed) = 0;
+
+  // Advances the physics by dt seconds under the given actuator values (entries of
+  // ToPlant signals; others are ignored), then writes every FromPlant entry of sensors.
+  // Sensors reflect the state at the end of the step.
+  virtual void step(double dt, const double* actuators, double* sensors) = 0;
+
+  // Sensor values of the current state without advancing (after reset: the initial state).
+  virtual void sense(double* sensors) const = 0;
+
+  // Counters for summaries: e.g. {"workpieces_stamped", 12}, {"workpieces_defective", 0}.
+  virtual std::vector<std::pair<std::string, double>> stats() const = 0;
+};
+
+// Creates a plant by name ("stamping"); config_path may be empty (defaults). Returns null
+// and fills err (with file:line for a bad config) when the name or config is invalid.
+std::unique_ptr<Plant> make_plant(const std::string& name, const std::string& config_path, std::string* err);
+// Names accepted by make_plant.
+std::vector<std::string> plant_names();
+
+}  // namespace plcfi::plant
