@@ -1,6 +1,9 @@
 // Collection and rendering of compiler diagnostics.
 #include "diag.hpp"
 
+#include <algorithm>
+#include <tuple>
+
 namespace plcfi::st {
 
 namespace {
@@ -57,8 +60,15 @@ std::string DiagEngine::render(const Diagnostic& d) const {
 }
 
 std::string DiagEngine::render_all() const {
+  // Source order, whichever stage found a problem first (declarations are checked
+  // after bodies start compiling, so collection order is not reading order).
+  std::vector<const Diagnostic*> order;
+  for (const auto& d : diags_) order.push_back(&d);
+  std::stable_sort(order.begin(), order.end(), [](const Diagnostic* a, const Diagnostic* b) {
+    return std::tie(a->loc.file, a->loc.line, a->loc.col) < std::tie(b->loc.file, b->loc.line, b->loc.col);
+  });
   std::string out;
-  for (const auto& d : diags_) out += render(d);
+  for (const Diagnostic* d : order) out += render(*d);
   if (errors_ + warnings_ > diags_.size())
     out += "(" + std::to_string(errors_ + warnings_ - diags_.size()) + " further diagnostics not shown)\n";
   return out;
