@@ -27,6 +27,7 @@ const std::vector<Command>& commands() {
       {"run", "run ST programs in virtual time and print variables", plcfi::cli::cmd_run},
       {"test", "run ST unit-test files", plcfi::cli::cmd_test},
       {"disasm", "print the bytecode of ST files with their source lines", plcfi::cli::cmd_disasm},
+      {"sim", "run a PLC program on a plant model in virtual time", plcfi::cli::cmd_sim},
   };
   return k;
 }

@@ -658,7 +658,81 @@ std::optional<Val> Compiler::conversion(const std::string& name, const CallExpr&
   return std::nullopt;
 }
 
+// Temporal operators of requirement formulas (EDTL), only in monitors: each occurrence
+// keeps its argument's current and previous value in hidden state; all are FALSE in the
+// first state.
+std::optional<Val> Compiler::temporal(const std::string& name, const CallExpr& c) {
+  static const char* kOps[] = {"RISING", "FALLING", "HIGH", "LOW", "CHANGES", "INCREASES", "DECREASES", "PASSED"};
+  bool known = false;
+  for (const char* k : kOps) known = known || name == k;
+  if (!known || !b_->pou || !b_->pou->late) return std::nullopt;
+  auto args = positional(c, 1, 1, name.c_str());
+  if (args.empty()) return bad();
+  const Type* BOOL = elem(TypeKind::Bool);
+  if (name == "PASSED") {
+    // time(i) - time(j) >= t, with the elapsed time since the timer point as an input.
+    const Symbol* el = lookup("__ELAPSED");
+    if (!el) {
+      diags_.error("ST211", c.loc, "PASSED is not available here");
+      return bad();
+    }
+    Val t = expr(*args[0]);
+    if (!t.ok) return bad();
+    if (!t.type || (t.type->kind != TypeKind::Time && t.type->kind != TypeKind::LTime)) {
+      diags_.error("ST203", args[0]->loc, "PASSED needs a duration such as T#2s, not " + (t.type ? t.type->name : std::string("a number")));
+      return bad();
+    }
+    Val e;
+    e.type = el->type;
+    e.slot = Slot{el->offset, SK::Var};
+    return combine(BinaryOp::Ge, e, t, c.loc);
+  }
+  bool edge = name == "RISING" || name == "FALLING" || name == "HIGH" || name == "LOW";
+  Val v = edge ? cond(*args[0]) : expr(*args[0]);
+  if (!v.ok) return bad();
+  const Type* t = v.type ? v.type : default_type(v.c);
+  if (!edge && !(t->is_numeric() || t->is_bitstring() || t->is_time_like() || t->kind == TypeKind::Enum || t->kind == TypeKind::Bool)) {
+    diags_.error("ST203", args[0]->loc, name + " needs a number, bit string, time or enumeration value, not " + t->name);
+    return bad();
+  }
+  if (!edge && (name != "CHANGES") && !(t->is_numeric() || t->is_time_like() || t->is_bitstring())) {
+    diags_.error("ST203", args[0]->loc, name + " needs an ordered value (a number or a time), not " + t->name);
+    return bad();
+  }
+  Slot cur = hidden(t->size, t->align), prev = hidden(t->size, t->align);
+  if (!b_->started) b_->started = hidden(1, 1);
+  Slot src = to_slot(v, t, args[0]->loc);
+  emit(mov_op(t->size), {cur, src});
+  b_->edges.push_back({cur, prev, t->size});
+  auto tmp_bool = [&]() { return temp(1, 1); };
+  Slot r = tmp_bool();
+  if (edge) {
+    // RISING: not prev and cur; FALLING: prev and not cur; HIGH: prev and cur; LOW: neither.
+    Slot a = cur, b = prev;
+    if (name == "RISING" || name == "LOW") {
+      b = tmp_bool();
+      emit(Op::BNOT, {b, prev});
+    }
+    if (name == "FALLING" || name == "LOW") {
+      a = tmp_bool();
+      emit(Op::BNOT, {a, cur});
+    }
+    emit(Op::BAND, {r, a, b});
+  } else {
+    Op cmp = name == "CHANGES" ? Op::NE_I8 : name == "INCREASES" ? Op::GT_I8 : Op::LT_I8;
+    emit(num_op(cmp, t->storage()), {r, cur, prev});
+  }
+  Slot out = tmp_bool();
+  emit(Op::BAND, {out, r, *b_->started});
+  def(out);
+  Val res;
+  res.type = BOOL;
+  res.slot = out;
+  return res;
+}
+
 std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c) {
+  if (auto v = temporal(name, c)) return v;
   if (auto v = conversion(name, c)) return v;
   auto first_type = [&](std::vector<Val>& vals) -> const Type* {
     const Type* t = nullptr;

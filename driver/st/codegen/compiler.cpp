@@ -206,6 +206,12 @@ Slot Compiler::konst(const Type* t, const ConstV& c, SourceLoc loc) {
 }
 
 Slot Compiler::konst_i64(int64_t v) { return konst_bytes(&v, 8, 8); }
+
+Slot Compiler::hidden(uint32_t size, uint32_t align) {
+  uint32_t off = align_up(b_->hidden_size, std::min<uint32_t>(align, 8));
+  b_->hidden_size = off + size;
+  return Slot{off, SK::Hidden};
+}
 Slot Compiler::konst_u32(uint32_t v) { return konst_bytes(&v, 4, 4); }
 
 // ------------------------------------------------------------------ POU bodies
@@ -287,8 +293,20 @@ void Compiler::compile_pou(PouInfo* p) {
   if (decl) stmts(decl->body);
   mark(decl ? decl->end_loc : SourceLoc{});
   emit(Op::RET, {});
+  if (p->late && p->kind == PouKind::Program) {
+    // Monitors: a second entry commits the state of the temporal operators (previous
+    // := current) once per state, after any number of evaluations of that state.
+    entries.push_back(static_cast<uint32_t>(b_->code.size()));
+    for (const auto& e : b_->edges) {
+      if (e.size == 1 || e.size == 2 || e.size == 4 || e.size == 8) emit(mov_op(e.size), {e.prev, e.cur});
+      else emit(Op::MOVN, {e.prev, e.cur, e.size});
+    }
+    if (b_->started) emit(Op::MOV1, {*b_->started, konst(elem(TypeKind::Bool), ConstV{ConstV::K::Bool, 1, 0, {}}, p->decl->loc)});
+    emit(Op::RET, {});
+  }
   finish_body(*body, p, &entries);
   p->entry = entries[0];
+  if (entries.size() > 1) p->commit_entry = entries[1];
   p->compiled = true;
   compiling_.pop_back();
 
@@ -313,10 +331,11 @@ void Compiler::compile_pou(PouInfo* p) {
 
 // Lays out constants and temporaries, patches operands and appends the body to the code.
 void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) {
-  uint32_t const_base = align_up(b.vars_end, 8);
+  uint32_t hidden_base = align_up(b.vars_end, 8);
+  uint32_t const_base = align_up(hidden_base + b.hidden_size, 8);
   uint32_t temp_base = align_up(const_base + static_cast<uint32_t>(b.consts.size()), 8);
   uint32_t frame_size = align_up(temp_base + b.temp_max, 8);
-  for (auto [idx, kind] : b.slot_fix) b.code[idx] += kind == SK::Const ? const_base : temp_base;
+  for (auto [idx, kind] : b.slot_fix) b.code[idx] += kind == SK::Const ? const_base : kind == SK::Hidden ? hidden_base : temp_base;
   p->frame_size = frame_size;
 
   // The frame's initial image: header, variables' initial values, constants.
@@ -418,7 +437,8 @@ void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
 // ------------------------------------------------------------------ the whole run
 
 std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUnit*>& units,
-                                           const std::vector<const TestFile*>& tests) {
+                                           const std::vector<const TestFile*>& tests,
+                                           const std::vector<const CompilationUnit*>& late) {
   app_ = std::make_unique<Application>();
   app_->types = std::make_unique<TypeTable>();
   tt_ = app_->types.get();
@@ -440,6 +460,9 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   std::vector<const CompilationUnit*> all = units;
   for (const auto* t : tests) all.push_back(&t->decls);
   for (const auto* u : all) index_unit(*u, u->file < sm_.size() && sm_.file(u->file).path == "<stdlib>");
+  size_t first_late = app_->pous.size();
+  for (const auto* u : late) index_unit(*u, false);
+  for (size_t i = first_late; i < app_->pous.size(); ++i) app_->pous[i]->late = true;
 
   // Inheritance and interfaces.
   auto link = [&](PouInfo* p) {
@@ -504,7 +527,8 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   }
 
   // Every POU is compiled (and so checked), used or not.
-  for (size_t i = 0; i < app_->pous.size(); ++i) ensure_compiled(app_->pous[i].get(), app_->pous[i]->decl->loc);
+  for (size_t i = 0; i < app_->pous.size(); ++i)
+    if (!app_->pous[i]->late) ensure_compiled(app_->pous[i].get(), app_->pous[i]->decl->loc);
   for (size_t i = 0; i < all_methods_.size(); ++i) ensure_compiled(all_methods_[i], all_methods_[i]->decl->loc);
 
   // Interface conformance: every method of every implemented interface must exist.
@@ -601,6 +625,19 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   for (const auto* tf : tests)
     for (const auto& tc : tf->tests) compile_test(*tf, tc);
 
+  // Late units see the program instances by path.
+  instance_paths_ = true;
+  for (const auto& p : app_->pous) {
+    if (!p->late) continue;
+    ensure_compiled(p.get(), p->decl->loc);
+    if (p->kind == PouKind::Program && p->compiled) {
+      ProgramInstance oi{p->name, p.get(), alloc(p->frame_size, 8), ""};
+      std::copy(p->type->init.begin(), p->type->init.end(), app_->init_image.begin() + oi.addr);
+      app_->observers.push_back(oi);
+    }
+  }
+  instance_paths_ = false;
+
   // Method frames live on a small stack of their own.
   app_->mstack_size = 64 * 1024;
   app_->mstack_addr = alloc(app_->mstack_size, 16);
@@ -626,9 +663,9 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
 
 std::unique_ptr<Application> compile(const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
                                      const std::vector<const TestFile*>& tests, DiagEngine& diags,
-                                     const CompileOptions& options) {
+                                     const CompileOptions& options, const std::vector<const CompilationUnit*>& late) {
   detail::Compiler c(sm, diags, options);
-  return c.run(units, tests);
+  return c.run(units, tests, late);
 }
 
 }  // namespace plcfi::st

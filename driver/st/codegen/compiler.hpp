@@ -20,9 +20,13 @@ struct CompileOptions {
 
 // Compiles the units (and test files) together with the standard library. Returns null
 // when any error was reported; diagnostics are in diags either way.
+// `late` units (requirement monitors) are compiled after the program instances exist:
+// inside them a path like Main.step names that instance's variable, and each of their
+// PROGRAMs gets one instance in Application::observers (not run by any task).
 std::unique_ptr<Application> compile(const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
                                      const std::vector<const TestFile*>& tests, DiagEngine& diags,
-                                     const CompileOptions& options);
+                                     const CompileOptions& options,
+                                     const std::vector<const CompilationUnit*>& late = {});
 
 // The standard library's ST source (standard FBs), compiled with every application.
 const char* stdlib_source();

@@ -22,8 +22,8 @@ namespace plcfi::st::detail {
 
 // A frame operand: a declared variable's offset, a temporary, or a constant-pool entry.
 // Temporaries and constants get their final offsets when the body is finished
-// (frame layout: [variables][constants][temporaries]).
-enum class SK : uint8_t { Var, Temp, Const };
+// (frame layout: [variables][hidden state][constants][temporaries]).
+enum class SK : uint8_t { Var, Temp, Const, Hidden };
 struct Slot {
   uint32_t off = 0;
   SK kind = SK::Var;
@@ -120,13 +120,22 @@ struct Body {
   };
   std::vector<Loop> loops;
   std::vector<std::unique_ptr<Symbol>> owned;  // This-symbols made for methods
+  // Monitors: state of temporal operators (current and previous value of each argument).
+  uint32_t hidden_size = 0;
+  struct Edge {
+    Slot cur, prev;
+    uint32_t size;
+  };
+  std::vector<Edge> edges;
+  std::optional<Slot> started;  // TRUE once a state has been committed
 };
 
 class Compiler {
  public:
   Compiler(const SourceManager& sm, DiagEngine& diags, const CompileOptions& opt);
   std::unique_ptr<Application> run(const std::vector<const CompilationUnit*>& units,
-                                   const std::vector<const TestFile*>& tests);
+                                   const std::vector<const TestFile*>& tests,
+                                   const std::vector<const CompilationUnit*>& late);
 
   // ---- declarations (decls.cpp)
   void index_unit(const CompilationUnit& u, bool stdlib);
@@ -166,6 +175,8 @@ class Compiler {
   Slot konst_bytes(const void* data, uint32_t size, uint32_t align);
   Slot konst_i64(int64_t v);
   Slot konst_u32(uint32_t v);
+  Slot hidden(uint32_t size, uint32_t align);
+  std::optional<Val> temporal(const std::string& name, const CallExpr& c);
 
   // ---- statements (stmt.cpp)
   void stmts(const StmtList& list);
@@ -263,6 +274,7 @@ class Compiler {
   std::vector<std::unique_ptr<PouInfo>> test_pous_;
   std::vector<std::unique_ptr<Pou>> synthetic_;
   uint32_t next_type_id_ = 1;
+  bool instance_paths_ = false;  // while compiling late units: Main.x names an instance variable
 };
 
 std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r, std::string* err);

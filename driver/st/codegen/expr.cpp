@@ -245,6 +245,17 @@ Place Compiler::place(const Expr& e, bool for_write) {
       if (m.base->kind == ExprKind::Name) {
         const auto& bn = static_cast<const NameExpr&>(*m.base);
         if (!lookup(canon(bn.name.text))) {
+          if (instance_paths_) {
+            // Main.x in a monitor: a variable of the program instance Main.
+            for (const auto& pi : app_->programs)
+              if (iequals(pi.name, bn.name.text)) {
+                Place inst;
+                inst.k = Place::K::Abs;
+                inst.type = pi.pou->type;
+                inst.off = pi.addr;
+                return member_place(inst, m.member, e.loc);
+              }
+          }
           for (const auto& g : app_->globals)
             if (iequals(g.scope, bn.name.text) && iequals(g.sym->name, m.member.text)) {
               if (for_write) ++g.sym->writes;
@@ -887,6 +898,8 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
           return std::nullopt;
         };
         if (auto pv = try_property()) return *pv;
+        if (m.base->kind == ExprKind::Name && !lookup(canon(static_cast<const NameExpr&>(*m.base).name.text)))
+          return load(place(e, false));  // GVL.x, or Main.x in a monitor
         Place base = place(*m.base, false);
         if (!base.ok) return bad();
         if (base.type->kind == TypeKind::Pou && !base.type->field(m.member.text) && base.type->pou) {

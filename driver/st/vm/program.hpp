@@ -82,10 +82,12 @@ struct PouInfo {
   uint32_t tmpl_from = 0, tmpl_to = 0;  // frame part (re)initialized per call, from a template
   uint32_t template_addr = 0;           // absolute address of that template
   uint32_t entry = 0;       // code index of the body
+  uint32_t commit_entry = 0;  // monitors: advances the temporal operators to the next state
   uint32_t selector = 0;    // METHOD: global selector for dynamic dispatch
   uint32_t mock_addr = 0;   // FUNCTION in test builds: {flag, pad, value} block
   bool declared = false;    // signature and variable layout done
   bool compiled = false;
+  bool late = false;        // compiled after the program instances (monitors)
   bool is_stdlib = false;
   bool recursion_mark = false;
 
@@ -144,6 +146,7 @@ class Application {
   std::vector<uint32_t> vtable;                        // [selector * n_types + type_id] -> entry
   uint32_t n_types = 0;
   std::vector<ProgramInstance> programs;
+  std::vector<ProgramInstance> observers;  // instances of late units' PROGRAMs (monitors)
   std::vector<TaskInfo> tasks;
   std::vector<TestEntry> tests;
   std::vector<GlobalVar> globals;

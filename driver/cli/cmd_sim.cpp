@@ -1,0 +1,263 @@
+// plcfi sim: a PLC program on a plant model in virtual time, with traces and a summary.
+#include <chrono>
+#include <iostream>
+
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "engine.hpp"
+#include "io/sim/sim_backend.hpp"
+#include "plant_model/plant.hpp"
+#include "report/trace.hpp"
+#include "runtime/runtime.hpp"
+
+namespace po = boost::program_options;
+
+namespace plcfi::cli {
+
+namespace {
+
+// Splits "a,b , c" into names.
+std::vector<std::string> split_list(const std::vector<std::string>& items) {
+  std::vector<std::string> out;
+  for (const auto& item : items) {
+    std::string cur;
+    for (char c : item + ",") {
+      if (c == ',') {
+        size_t b = cur.find_first_not_of(' '), e = cur.find_last_not_of(' ');
+        if (b != std::string::npos) out.push_back(cur.substr(b, e - b + 1));
+        cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+  }
+  return out;
+}
+
+// Records when each alarm variable rose, and how often.
+class AlarmWatch final : public rt::ScanHooks {
+ public:
+  explicit AlarmWatch(std::vector<st::VarHandle> vars) : vars_(std::move(vars)), prev_(vars_.size(), false),
+                                                          first_(vars_.size(), -1), rises_(vars_.size(), 0) {}
+  void end_of_scan(rt::Runtime& r) override {
+    for (size_t i = 0; i < vars_.size(); ++i) {
+      bool v = st::read_bool(r.machine(), vars_[i]);
+      if (v && !prev_[i]) {
+        ++rises_[i];
+        if (first_[i] < 0) first_[i] = r.now();
+      }
+      prev_[i] = v;
+    }
+  }
+  std::string summary() const {
+    std::string out;
+    for (size_t i = 0; i < vars_.size(); ++i)
+      if (rises_[i])
+        out += fmt::format("{}{} (first at {:.3f} s, raised {}x)", out.empty() ? "" : ", ", vars_[i].path,
+                           static_cast<double>(first_[i]) * 1e-9, rises_[i]);
+    return out.empty() ? "none" : out;
+  }
+  size_t raised() const {
+    size_t n = 0;
+    for (auto r : rises_) n += r != 0;
+    return n;
+  }
+
+ private:
+  std::vector<st::VarHandle> vars_;
+  std::vector<bool> prev_;
+  std::vector<int64_t> first_;
+  std::vector<uint64_t> rises_;
+};
+
+class TraceHook final : public rt::ScanHooks {
+ public:
+  explicit TraceHook(std::vector<report::TraceWriter*> w) : writers_(std::move(w)) {}
+  void end_of_scan(rt::Runtime& r) override {
+    for (auto* w : writers_) w->sample(r.now(), r.machine());
+  }
+
+ private:
+  std::vector<report::TraceWriter*> writers_;
+};
+
+bool is_alarm_name(const std::string& name) {
+  std::string c = st::canon(name);
+  for (const char* k : {"ERROR", "ALARM", "WARNING", "STOP", "FAULT"})
+    if (c.find(k) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+int cmd_sim(const std::vector<std::string>& args) {
+  po::options_description desc("plcfi sim: run a PLC program on a plant model in virtual time");
+  desc.add_options()
+      ("program", po::value<std::vector<std::string>>()->multitoken(), "ST files of the program (also accepted as plain arguments)")
+      ("plant", po::value<std::string>()->default_value("stamping"), "plant model")
+      ("plant-config", po::value<std::string>(), "plant parameters (YAML)")
+      ("seed", po::value<uint64_t>()->default_value(1), "seed of the plant's random variation")
+      ("duration", po::value<std::string>()->default_value("1h"), "simulated time, e.g. 90s, 10m, 1h")
+      ("cycle-time", po::value<std::string>()->default_value("10ms"), "cycle time when the program has no CONFIGURATION")
+      ("vcd", po::value<std::string>(), "write a VCD trace")
+      ("csv", po::value<std::string>(), "write a CSV trace (one row per scan)")
+      ("watch", po::value<std::vector<std::string>>(), "variables to trace, comma-separated (default: the plant's signals and the alarms)")
+      ("alarms", po::value<std::vector<std::string>>(), "alarm variables to report (default: BOOL globals named *Error*, *Alarm*, *Warning*, *Stop*, *Fault*)");
+  desc.add_options()("help,h", "show this help");
+  po::options_description all;
+  all.add(desc);
+  all.add_options()("files", po::value<std::vector<std::string>>(), "");
+  po::positional_options_description pos;
+  pos.add("files", -1);
+  po::variables_map vm;
+  po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
+  po::notify(vm);
+  if (vm.count("help")) {
+    std::cout << "usage: plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
+                 "[--vcd F] [--csv F] [--watch PATH,...]\n\n"
+              << desc << "\n";
+    return 0;
+  }
+  std::vector<std::string> files;
+  if (vm.count("program")) files = vm["program"].as<std::vector<std::string>>();
+  if (vm.count("files"))
+    for (const auto& f : vm["files"].as<std::vector<std::string>>()) files.push_back(f);
+  if (files.empty()) {
+    std::cerr << "plcfi sim: no program files (--program FILE...)\n";
+    return 2;
+  }
+  st::CompileOptions opt;
+  opt.warnings = false;
+  auto b = st::build_files(files, opt);
+  for (const auto& e : b->io_errors) std::cerr << e << "\n";
+  std::cerr << b->diags.render_all();
+  if (!b->ok()) return 2;
+  const st::Application& app = *b->app;
+
+  std::string err;
+  int64_t duration = 0, cycle = 0;
+  if (!rt::parse_duration(vm["duration"].as<std::string>(), &duration, &err) || duration <= 0) {
+    std::cerr << "plcfi sim: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
+    return 2;
+  }
+  if (!rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
+    std::cerr << "plcfi sim: --cycle-time: " << err << "\n";
+    return 2;
+  }
+  rt::Schedule sched;
+  bool ok = app.has_configuration ? sched.from_configuration(app, &err) : sched.single_program(app, "", cycle, &err);
+  if (!ok) {
+    std::cerr << "plcfi sim: " << err << "\n";
+    return 2;
+  }
+  auto plant = plant::make_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
+  if (!plant) {
+    std::cerr << "plcfi sim: " << err << "\n";
+    return 2;
+  }
+  auto backend = io::SimBackend::create(app, std::move(plant), &err);
+  if (!backend) {
+    std::cerr << "plcfi sim: " << err << "\n";
+    return 2;
+  }
+  rt::Runtime runtime(app, sched, backend.get());
+
+  // Alarm variables.
+  std::vector<st::VarHandle> alarms;
+  if (vm.count("alarms")) {
+    for (const auto& p : split_list(vm["alarms"].as<std::vector<std::string>>())) {
+      auto h = st::resolve(app, p, &err);
+      if (!h) {
+        std::cerr << "plcfi sim: --alarms: " << err << "\n";
+        return 2;
+      }
+      alarms.push_back(*h);
+    }
+  } else {
+    for (const auto& g : app.globals)
+      if (g.sym->type->kind == st::TypeKind::Bool && is_alarm_name(g.sym->name)) {
+        auto h = st::resolve(app, g.sym->name, &err);
+        if (h) alarms.push_back(*h);
+      }
+  }
+  AlarmWatch alarm_watch(alarms);
+  runtime.add_hooks(&alarm_watch);
+
+  // Traces.
+  std::vector<st::VarHandle> watch;
+  if (vm.count("watch")) {
+    for (const auto& p : split_list(vm["watch"].as<std::vector<std::string>>())) {
+      auto h = st::resolve(app, p, &err);
+      if (!h) {
+        std::cerr << "plcfi sim: --watch: " << err << "\n";
+        return 2;
+      }
+      watch.push_back(*h);
+    }
+  } else if (vm.count("vcd") || vm.count("csv")) {
+    for (const auto& s : backend->plant().signals()) {
+      auto h = st::resolve(app, s.name, &err);  // the program's name for the signal, if any
+      if (!h) h = st::resolve(app, s.address, &err);
+      if (h) {
+        h->path = s.name;
+        watch.push_back(*h);
+      }
+    }
+    for (const auto& a : alarms) watch.push_back(a);
+  }
+  std::vector<std::unique_ptr<report::TraceWriter>> writers;
+  if (vm.count("vcd")) {
+    auto w = report::open_vcd(vm["vcd"].as<std::string>(), watch, &err);
+    if (!w) {
+      std::cerr << "plcfi sim: --vcd: " << err << "\n";
+      return 2;
+    }
+    writers.push_back(std::move(w));
+  }
+  if (vm.count("csv")) {
+    auto w = report::open_csv(vm["csv"].as<std::string>(), watch, &err);
+    if (!w) {
+      std::cerr << "plcfi sim: --csv: " << err << "\n";
+      return 2;
+    }
+    writers.push_back(std::move(w));
+  }
+  std::vector<report::TraceWriter*> raw;
+  for (auto& w : writers) raw.push_back(w.get());
+  TraceHook trace(raw);
+  if (!raw.empty()) runtime.add_hooks(&trace);
+
+  uint64_t seed = vm["seed"].as<uint64_t>();
+  runtime.cold_restart(seed);
+  uint64_t scans = static_cast<uint64_t>(duration / sched.tick_ns());
+  auto t0 = std::chrono::steady_clock::now();
+  std::string trap_text;
+  for (uint64_t n = 0; n < scans; ++n) {
+    if (runtime.scan() == rt::ScanStatus::Trapped) trap_text = runtime.stop_reason();
+  }
+  double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (auto& w : writers)
+    if (!w->close(&err)) {
+      std::cerr << "plcfi sim: " << err << "\n";
+      return 2;
+    }
+  double simulated = static_cast<double>(runtime.now()) * 1e-9;
+  std::cout << fmt::format("plcfi sim: {} on plant {} (seed {}), base tick {} ms\n", files.back(), backend->plant().name(), seed,
+                           static_cast<double>(sched.tick_ns()) / 1e6);
+  std::cout << fmt::format("  simulated time  {:.3f} s ({} scans)\n", simulated, runtime.scan_count());
+  std::cout << fmt::format("  wall time       {:.3f} s\n", wall);
+  std::cout << fmt::format("  speed           {:.0f}x real time (simulated seconds per wall second)\n", wall > 0 ? simulated / wall : 0.0);
+  std::string stats;
+  for (const auto& [k, v] : backend->plant().stats()) stats += fmt::format("{}{} {}", stats.empty() ? "" : ", ", k, v);
+  std::cout << "  plant           " << stats << "\n";
+  std::cout << "  alarms raised   " << alarm_watch.summary() << "\n";
+  if (!trap_text.empty()) {
+    std::cout << "  program stopped " << trap_text << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace plcfi::cli

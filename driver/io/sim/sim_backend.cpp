@@ -1,0 +1,66 @@
+// Plant-model backend.
+#include "sim_backend.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plcfi::io {
+
+std::unique_ptr<SimBackend> SimBackend::create(const st::Application& app, std::unique_ptr<plant::Plant> plant,
+                                               std::string* err) {
+  std::unique_ptr<SimBackend> b(new SimBackend());
+  b->name_ = "sim:" + plant->name();
+  const auto& sigs = plant->signals();
+  b->values_.assign(sigs.size(), 0.0);
+  for (size_t i = 0; i < sigs.size(); ++i) {
+    const auto& s = sigs[i];
+    rt::ImageRef ref;
+    std::string e;
+    if (!rt::parse_image_ref(app, s.address, &ref, &e)) {
+      *err = "plant " + plant->name() + ", signal " + s.name + ": " + e;
+      return nullptr;
+    }
+    char want = s.dir == plant::Direction::FromPlant ? 'I' : 'Q';
+    if (ref.area != want) {
+      *err = "plant " + plant->name() + ", signal " + s.name + ": a " +
+             (want == 'I' ? std::string("sensor belongs in %I") : std::string("actuator belongs in %Q")) + ", not " + s.address;
+      return nullptr;
+    }
+    if ((s.kind == plant::SignalKind::Bool) != ref.is_bit) {
+      *err = "plant " + plant->name() + ", signal " + s.name + ": " +
+             (ref.is_bit ? "an analog signal needs a word address, not " : "a BOOL signal needs a bit address, not ") + s.address;
+      return nullptr;
+    }
+    uint32_t end = ref.offset + ref.size;
+    if (want == 'I') {
+      b->in_extent_ = std::max(b->in_extent_, end);
+      b->sensors_.push_back(i);
+    } else {
+      b->out_extent_ = std::max(b->out_extent_, end);
+      b->actuators_.push_back(i);
+    }
+    b->refs_.push_back(ref);
+  }
+  b->plant_ = std::move(plant);
+  b->reset(0);
+  return b;
+}
+
+bool SimBackend::read(uint8_t* inputs, int64_t) {
+  for (size_t i : sensors_) refs_[i].set(inputs, static_cast<int64_t>(std::lround(values_[i])));
+  return true;
+}
+
+bool SimBackend::write(const uint8_t* outputs, int64_t, int64_t dt_ns) {
+  for (size_t i : actuators_) values_[i] = static_cast<double>(refs_[i].get(outputs));
+  plant_->step(static_cast<double>(dt_ns) * 1e-9, values_.data(), values_.data());
+  return true;
+}
+
+void SimBackend::reset(uint64_t seed) {
+  plant_->reset(seed);
+  std::fill(values_.begin(), values_.end(), 0.0);
+  plant_->sense(values_.data());
+}
+
+}  // namespace plcfi::io
