@@ -13,6 +13,8 @@
 //
 // After the runs a table prints VM ns/scan, native ns/scan and the ratio per kernel (CPU
 // time, the minimum over repetitions when --benchmark_repetitions is given).
+//
+// `plcfi_bench --disasm=<kernel>` prints the kernel's bytecode instead (for profiling).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -485,6 +487,15 @@ benchmark::ConsoleReporter::OutputOptions console_options(int argc, char** argv)
 }
 
 int main(int argc, char** argv) {
+  // --disasm=<kernel>: print the kernel's bytecode (st::disassemble) and exit.
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.rfind("--disasm=", 0) == 0) {
+      const VmKernel& k = kernel(a.substr(9));
+      std::fputs(st::disassemble(*k.build->app, k.build.get()).c_str(), stdout);
+      return 0;
+    }
+  }
   const auto options = console_options(argc, argv);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
