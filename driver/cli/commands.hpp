@@ -11,5 +11,6 @@ int cmd_run(const std::vector<std::string>& args);
 int cmd_test(const std::vector<std::string>& args);
 int cmd_disasm(const std::vector<std::string>& args);
 int cmd_sim(const std::vector<std::string>& args);
+int cmd_edtl(const std::vector<std::string>& args);
 
 }  // namespace plcfi::cli

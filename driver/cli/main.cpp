@@ -28,6 +28,7 @@ const std::vector<Command>& commands() {
       {"test", "run ST unit-test files", plcfi::cli::cmd_test},
       {"disasm", "print the bytecode of ST files with their source lines", plcfi::cli::cmd_disasm},
       {"sim", "run a PLC program on a plant model in virtual time", plcfi::cli::cmd_sim},
+      {"edtl", "check EDTL requirements on a recorded trace (edtl check REQS TRACE)", plcfi::cli::cmd_edtl},
   };
   return k;
 }

@@ -27,24 +27,28 @@ void st(uint8_t* p, T v) {
   std::memcpy(p, &v, sizeof(T));
 }
 
-std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32_t>& files, const CompileOptions& opt) {
+std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32_t>& files, const CompileOptions& opt,
+                              const NamedSources& late) {
   for (uint32_t f : files) {
     if (is_test_file(b->sm, f)) b->tests.push_back(parse_test_file(b->sm, f, b->diags));
     else b->units.push_back(parse_unit(b->sm, f, b->diags));
   }
+  for (const auto& [name, text] : late) b->late.push_back(parse_unit(b->sm, b->sm.add(name, text), b->diags));
   if (b->diags.has_errors() || !b->io_errors.empty()) return b;
   std::vector<const CompilationUnit*> units;
   for (const auto& u : b->units) units.push_back(u.get());
   std::vector<const TestFile*> tests;
   for (const auto& t : b->tests) tests.push_back(t.get());
-  b->app = compile(b->sm, units, tests, b->diags, opt);
+  std::vector<const CompilationUnit*> late_units;
+  for (const auto& u : b->late) late_units.push_back(u.get());
+  b->app = compile(b->sm, units, tests, b->diags, opt, late_units);
   return b;
 }
 
 uint32_t add_stdlib(Build& b) { return b.sm.add("<stdlib>", stdlib_source()); }
 }  // namespace
 
-std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt) {
+std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt, const NamedSources& late) {
   auto b = std::make_unique<Build>();
   std::vector<uint32_t> files{add_stdlib(*b)};
   for (const auto& p : paths) {
@@ -56,15 +60,14 @@ std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const 
     }
     files.push_back(idx);
   }
-  return finish(std::move(b), files, opt);
+  return finish(std::move(b), files, opt, late);
 }
 
-std::unique_ptr<Build> build_sources(const std::vector<std::pair<std::string, std::string>>& sources,
-                                     const CompileOptions& opt) {
+std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileOptions& opt, const NamedSources& late) {
   auto b = std::make_unique<Build>();
   std::vector<uint32_t> files{add_stdlib(*b)};
   for (const auto& [name, text] : sources) files.push_back(b->sm.add(name, text));
-  return finish(std::move(b), files, opt);
+  return finish(std::move(b), files, opt, late);
 }
 
 // ------------------------------------------------------------------ handles

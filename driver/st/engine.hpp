@@ -23,17 +23,20 @@ struct Build {
   DiagEngine diags{sm};
   std::vector<std::unique_ptr<CompilationUnit>> units;
   std::vector<std::unique_ptr<TestFile>> tests;
+  std::vector<std::unique_ptr<CompilationUnit>> late;  // monitors
   std::unique_ptr<Application> app;
   std::vector<std::string> io_errors;  // files that could not be read
 
   bool ok() const { return app != nullptr; }
 };
 
-// Reads and compiles files. Returns the build; check ok(), diags and io_errors.
-std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt);
-// Same from in-memory sources (name, text): tests and benchmarks.
-std::unique_ptr<Build> build_sources(const std::vector<std::pair<std::string, std::string>>& sources,
-                                     const CompileOptions& opt);
+using NamedSources = std::vector<std::pair<std::string, std::string>>;
+// Reads and compiles files. Returns the build; check ok(), diags and io_errors. `late`
+// sources (requirement monitors) are compiled after the program instances exist.
+std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt,
+                                   const NamedSources& late = {});
+// Same from in-memory sources (name, text): tests, benchmarks, trace programs.
+std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileOptions& opt, const NamedSources& late = {});
 
 // A variable resolved once from its path (`Main.seq.step`, `GVL.x`, `x`, `%IX0.3`,
 // `Main.buf[3].v`, `Main.w.2`) to a typed location; reads and writes are O(1).

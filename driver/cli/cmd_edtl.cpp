@@ -1,0 +1,179 @@
+// plcfi edtl check: EDTL requirements checked offline on a recorded trace.
+#include <iostream>
+
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "engine.hpp"
+#include "monitor/edtl.hpp"
+#include "monitor/trace_reader.hpp"
+#include "report/junit.hpp"
+#include "runtime/schedule.hpp"
+
+namespace po = boost::program_options;
+
+namespace plcfi::cli {
+
+namespace {
+
+std::string json_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (c == '\n') out += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
+    else out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string verdicts_json(const std::vector<monitor::Verdict>& vs) {
+  std::string out = "[";
+  for (size_t i = 0; i < vs.size(); ++i) {
+    const auto& v = vs[i];
+    out += fmt::format("{}{{\"id\": \"{}\", \"text\": \"{}\", \"verdict\": \"{}\", \"triggers\": {}, \"held\": {}, \"violated\": {}, "
+                       "\"pending\": {}, \"violations\": [",
+                       i ? ", " : "", json_escape(v.id), json_escape(v.text), v.violated() ? "VIOLATED" : "SATISFIED", v.triggers,
+                       v.holds, v.violated_instances, v.pending);
+    for (size_t k = 0; k < v.violations.size(); ++k) {
+      const auto& x = v.violations[k];
+      out += fmt::format("{}{{\"trigger_state\": {}, \"trigger_time\": {:.9f}, \"state\": {}, \"time\": {:.9f}, \"cause\": \"{}\"}}",
+                         k ? ", " : "", x.trigger_state, static_cast<double>(x.trigger_time_ns) * 1e-9, x.state,
+                         static_cast<double>(x.time_ns) * 1e-9, x.cause == monitor::Cause::Invariant ? "invariant" : "delay");
+    }
+    out += "]}";
+  }
+  return out + "]";
+}
+
+bool write_verdicts_junit(const std::string& path, const std::string& suite, const std::vector<monitor::Verdict>& vs,
+                          std::string* err) {
+  report::JunitSuite s;
+  s.name = suite;
+  for (const auto& v : vs) {
+    report::JunitCase c;
+    c.classname = suite;
+    c.name = v.id + (v.text.empty() ? "" : ": " + v.text);
+    if (v.violated()) {
+      c.outcome = report::JunitCase::Outcome::Fail;
+      const auto& x = v.violations.front();
+      c.message = fmt::format("violated at state {} (t={:.3f} s): {}", x.state, static_cast<double>(x.time_ns) * 1e-9,
+                              monitor::cause_text(x.cause));
+      c.detail = monitor::format_verdicts({v});
+    }
+    c.properties = {{"triggers", std::to_string(v.triggers)}, {"pending", std::to_string(v.pending)}};
+    if (!v.severity.empty()) c.properties.emplace_back("severity", v.severity);
+    s.cases.push_back(c);
+  }
+  return report::write_junit(path, {s}, err);
+}
+
+int cmd_edtl(const std::vector<std::string>& args) {
+  if (args.empty() || args[0] == "--help" || args[0] == "-h") {
+    std::cout << "usage: plcfi edtl check REQS.yaml TRACE [--cycle-time 1s] [--junit F] [--json]\n"
+                 "  Checks EDTL requirements on a CSV or VCD trace. Exit 1 when any is violated.\n";
+    return args.empty() ? 2 : 0;
+  }
+  if (args[0] != "check") {
+    std::cerr << "plcfi edtl: unknown subcommand '" << args[0] << "' (expected 'check')\n";
+    return 2;
+  }
+  po::options_description desc("plcfi edtl check: EDTL requirements on a recorded trace");
+  desc.add_options()("cycle-time", po::value<std::string>(), "time between states when the trace has no time column (default 1s); for VCD: sample every cycle")
+      ("junit", po::value<std::string>(), "write JUnit XML")("json", "print the verdicts as JSON")("help,h", "show this help");
+  po::options_description all;
+  all.add(desc);
+  all.add_options()("files", po::value<std::vector<std::string>>(), "");
+  po::positional_options_description pos;
+  pos.add("files", -1);
+  po::variables_map vm;
+  po::store(po::command_line_parser(std::vector<std::string>(args.begin() + 1, args.end())).options(all).positional(pos).run(), vm);
+  po::notify(vm);
+  if (vm.count("help")) {
+    std::cout << "usage: plcfi edtl check REQS.yaml TRACE [--cycle-time 1s] [--junit F] [--json]\n\n" << desc << "\n";
+    return 0;
+  }
+  auto files = vm.count("files") ? vm["files"].as<std::vector<std::string>>() : std::vector<std::string>{};
+  if (files.size() != 2) {
+    std::cerr << "plcfi edtl check: expected REQS.yaml and TRACE\n";
+    return 2;
+  }
+  std::string err;
+  int64_t cycle = 0;
+  if (vm.count("cycle-time") && !rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
+    std::cerr << "plcfi edtl check: --cycle-time: " << err << "\n";
+    return 2;
+  }
+  monitor::RequirementsFile reqs;
+  if (!monitor::load_requirements(files[0], &reqs, &err)) {
+    std::cerr << err << "\n";
+    return 2;
+  }
+  bool is_vcd = files[1].size() > 4 && files[1].substr(files[1].size() - 4) == ".vcd";
+  auto reader = monitor::TraceReader::open(files[1], cycle ? cycle : (is_vcd ? 0 : 1'000'000'000), &err);
+  if (!reader) {
+    std::cerr << err << "\n";
+    return 2;
+  }
+  std::string program;
+  if (!monitor::trace_program(reader->columns(), &program, &err)) {
+    std::cerr << files[1] << ": " << err << "\n";
+    return 2;
+  }
+  auto mon = monitor::generate_monitors(reqs);
+  st::CompileOptions opt;
+  opt.warnings = false;
+  auto b = st::build_sources({{"<trace:" + files[1] + ">", program}}, opt, {{mon.name, mon.text}});
+  monitor::remap_diagnostics(*b, mon, reqs);
+  std::cerr << b->diags.render_all();
+  if (!b->ok()) return 2;
+  auto set = monitor::MonitorSet::create(*b->app, reqs, &err);
+  if (!set) {
+    std::cerr << "plcfi edtl check: " << err << "\n";
+    return 2;
+  }
+  st::Machine m(*b->app);
+  std::vector<st::VarHandle> handles;
+  for (const auto& c : reader->columns()) {
+    auto h = st::resolve(*b->app, c.name, &err);
+    if (!h) {
+      std::cerr << files[1] << ": column " << c.name << ": " << err << "\n";
+      return 2;
+    }
+    handles.push_back(*h);
+  }
+  std::vector<double> values;
+  int64_t t = 0;
+  uint64_t state = 0;
+  while (reader->next(&t, &values, &err)) {
+    for (size_t i = 0; i < handles.size(); ++i) {
+      if (handles[i].type->is_real()) st::write_real(m, handles[i], values[i]);
+      else st::write_int(m, handles[i], static_cast<int64_t>(values[i]));
+    }
+    m.set_now(t);
+    set->step(m, state++, t);
+  }
+  if (!err.empty()) {
+    std::cerr << err << "\n";
+    return 2;
+  }
+  auto verdicts = set->verdicts();
+  if (vm.count("json")) {
+    std::cout << fmt::format("{{\"trace\": \"{}\", \"states\": {}, \"requirements\": {}}}\n", json_escape(files[1]), state,
+                             verdicts_json(verdicts));
+  } else {
+    std::cout << fmt::format("{}: {} states\n", files[1], state) << monitor::format_verdicts(verdicts);
+  }
+  if (vm.count("junit") && !write_verdicts_junit(vm["junit"].as<std::string>(), files[0], verdicts, &err)) {
+    std::cerr << "plcfi edtl check: " << err << "\n";
+    return 2;
+  }
+  for (const auto& v : verdicts)
+    if (v.violated()) return 1;
+  return 0;
+}
+
+}  // namespace plcfi::cli

@@ -1,0 +1,408 @@
+// EDTL requirements: loading, translation to monitor programs, and the checking procedure.
+#include "edtl.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+namespace plcfi::monitor {
+
+// ------------------------------------------------------------------ loading
+
+namespace {
+
+std::string where(const std::string& path, const YAML::Mark& m) {
+  return fmt::format("{}:{}:{}", path, m.line + 1, m.column + 1);
+}
+
+bool read_formula(const std::string& path, const YAML::Node& node, FormulaSource* f, std::string* err) {
+  if (!node.IsScalar()) {
+    *err = where(path, node.Mark()) + ": a formula must be a string (an ST expression)";
+    return false;
+  }
+  f->text = node.Scalar();
+  f->line = static_cast<uint32_t>(node.Mark().line + 1);
+  f->col = static_cast<uint32_t>(node.Mark().column + 1);
+  // Quoted scalars start one column after the quote.
+  if (node.Tag() == "!") f->col += 1;
+  return true;
+}
+
+}  // namespace
+
+bool load_requirements(const std::string& path, RequirementsFile* out, std::string* err) {
+  std::ifstream in(path);
+  if (!in) {
+    *err = path + ": cannot open";
+    return false;
+  }
+  YAML::Node root;
+  try {
+    root = YAML::Load(in);
+  } catch (const YAML::Exception& e) {
+    *err = where(path, e.mark) + ": " + e.msg;
+    return false;
+  }
+  out->path = path;
+  YAML::Node list = root;
+  if (root.IsMap()) {
+    for (const auto& kv : root)
+      if (kv.first.Scalar() != "requirements") {
+        *err = where(path, kv.first.Mark()) + ": unknown key '" + kv.first.Scalar() + "' (expected 'requirements')";
+        return false;
+      }
+    list = root["requirements"];
+  }
+  if (!list || !list.IsSequence()) {
+    *err = path + ":1:1: expected a list of requirements (or a map with the key 'requirements')";
+    return false;
+  }
+  static const char* kKeys[] = {"id", "text", "severity", "trigger", "invariant", "final", "delay", "reaction", "release"};
+  for (const auto& item : list) {
+    if (!item.IsMap()) {
+      *err = where(path, item.Mark()) + ": a requirement is a map with id, text and the formulas";
+      return false;
+    }
+    RequirementSpec r;
+    r.line = static_cast<uint32_t>(item.Mark().line + 1);
+    r.invariant.text = "TRUE";
+    r.final.text = "TRUE";
+    r.delay.text = "TRUE";
+    r.reaction.text = "TRUE";
+    r.release.text = "FALSE";
+    for (const auto& kv : item) {
+      std::string key = kv.first.Scalar();
+      if (std::find(std::begin(kKeys), std::end(kKeys), key) == std::end(kKeys)) {
+        *err = where(path, kv.first.Mark()) + ": unknown key '" + key +
+               "' (expected id, text, severity, trigger, invariant, final, delay, reaction, release)";
+        return false;
+      }
+      const YAML::Node& v = kv.second;
+      if (key == "id" || key == "text" || key == "severity") {
+        if (!v.IsScalar()) {
+          *err = where(path, v.Mark()) + ": '" + key + "' must be a string";
+          return false;
+        }
+        (key == "id" ? r.id : key == "text" ? r.text : r.severity) = v.Scalar();
+        continue;
+      }
+      FormulaSource* f = key == "trigger" ? &r.trigger : key == "invariant" ? &r.invariant : key == "final" ? &r.final
+                         : key == "delay" ? &r.delay : key == "reaction" ? &r.reaction : &r.release;
+      if (!read_formula(path, v, f, err)) return false;
+    }
+    if (r.id.empty()) {
+      *err = where(path, item.Mark()) + ": requirement without an 'id'";
+      return false;
+    }
+    if (r.trigger.line == 0) {
+      *err = where(path, item.Mark()) + ": requirement '" + r.id + "' has no trigger";
+      return false;
+    }
+    for (const auto& other : out->requirements)
+      if (other.id == r.id) {
+        *err = where(path, item.Mark()) + ": requirement id '" + r.id + "' is used twice";
+        return false;
+      }
+    out->requirements.push_back(std::move(r));
+  }
+  if (out->requirements.empty()) {
+    *err = path + ":1:1: no requirements";
+    return false;
+  }
+  return true;
+}
+
+// ------------------------------------------------------------------ translation
+
+std::string expand_symbols(const std::string& text, std::vector<uint32_t>* pos_map) {
+  std::string out;
+  pos_map->clear();
+  auto emit = [&](const std::string& s, uint32_t src) {
+    for (char c : s) {
+      out += c;
+      pos_map->push_back(src);
+    }
+  };
+  // Prefix position: at the start, after '(' ',' an operator, or a keyword operator.
+  auto prefix_position = [&]() {
+    size_t i = out.size();
+    while (i > 0 && std::isspace(static_cast<unsigned char>(out[i - 1]))) --i;
+    if (i == 0) return true;
+    char c = out[i - 1];
+    if (std::string("(,+-*/=<>&").find(c) != std::string::npos) return true;
+    size_t j = i;
+    while (j > 0 && (std::isalnum(static_cast<unsigned char>(out[j - 1])) || out[j - 1] == '_')) --j;
+    std::string word = out.substr(j, i - j);
+    for (auto& ch : word) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+    return word == "AND" || word == "OR" || word == "XOR" || word == "NOT" || word == "MOD";
+  };
+  // The operand of a symbolic form: a parenthesized group or a path (a.b[1].c, %IX0.1).
+  auto operand_end = [&](size_t i) {
+    if (i < text.size() && text[i] == '(') {
+      int depth = 0;
+      for (size_t k = i; k < text.size(); ++k) {
+        if (text[k] == '(') ++depth;
+        if (text[k] == ')' && --depth == 0) return k + 1;
+      }
+      return text.size();
+    }
+    size_t k = i;
+    int bracket = 0;
+    while (k < text.size()) {
+      char c = text[k];
+      if (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '%' || c == '#') ++k;
+      else if (c == '[') ++bracket, ++k;
+      else if (c == ']' && bracket > 0) --bracket, ++k;
+      else if (bracket > 0) ++k;
+      else break;
+    }
+    return k;
+  };
+  size_t i = 0;
+  while (i < text.size()) {
+    char c = text[i];
+    bool sym = (c == '/' || c == '\\' || c == '~' || c == '_') && i + 1 < text.size() &&
+               (std::isalpha(static_cast<unsigned char>(text[i + 1])) || text[i + 1] == '(' || text[i + 1] == '%' ||
+                (c != '_' && text[i + 1] == '_'));
+    if (sym && c == '_' && i > 0 && (std::isalnum(static_cast<unsigned char>(text[i - 1])) || text[i - 1] == '_')) sym = false;
+    if (sym && prefix_position()) {
+      const char* fn = c == '/' ? "RISING(" : c == '\\' ? "FALLING(" : c == '~' ? "HIGH(" : "LOW(";
+      emit(fn, static_cast<uint32_t>(i));
+      size_t end = operand_end(i + 1);
+      for (size_t k = i + 1; k < end; ++k) {
+        out += text[k];
+        pos_map->push_back(static_cast<uint32_t>(k));
+      }
+      emit(")", static_cast<uint32_t>(end > 0 ? end - 1 : 0));
+      i = end;
+      continue;
+    }
+    out += c;
+    pos_map->push_back(static_cast<uint32_t>(i));
+    ++i;
+  }
+  return out;
+}
+
+namespace {
+const char* kOutputs[] = {"__o_trig", "__o_inv", "__o_fin", "__o_del", "__o_react", "__o_rel"};
+
+std::string program_name(size_t i) { return "__EDTL_" + std::to_string(i + 1); }
+}  // namespace
+
+MonitorSource generate_monitors(const RequirementsFile& reqs) {
+  MonitorSource src;
+  src.name = "<monitors:" + reqs.path + ">";
+  auto line = [&](const std::string& s) {
+    src.text += s + "\n";
+    src.lines.emplace_back();
+  };
+  for (size_t i = 0; i < reqs.requirements.size(); ++i) {
+    const auto& r = reqs.requirements[i];
+    line("PROGRAM " + program_name(i));
+    line("VAR_INPUT __elapsed : LTIME; END_VAR");
+    line("VAR_OUTPUT __o_trig, __o_inv, __o_fin, __o_del, __o_react, __o_rel : BOOL; END_VAR");
+    const FormulaSource* fs[] = {&r.trigger, &r.invariant, &r.final, &r.delay, &r.reaction, &r.release};
+    for (int k = 0; k < 6; ++k) {
+      line(std::string(kOutputs[k]) + " := (");
+      std::vector<uint32_t> map;
+      std::string body = expand_symbols(fs[k]->text, &map);
+      // A formula spans one generated line; newlines inside it are spaces.
+      for (char& c : body)
+        if (c == '\n' || c == '\r') c = ' ';
+      line(body);
+      src.lines.back().formula = fs[k];
+      src.lines.back().pos_map = std::move(map);
+      line(");");
+    }
+    line("END_PROGRAM");
+  }
+  return src;
+}
+
+void remap_diagnostics(st::Build& build, const MonitorSource& src, const RequirementsFile& reqs) {
+  uint32_t gen = UINT32_MAX, yaml = UINT32_MAX;
+  for (uint32_t f = 0; f < build.sm.size(); ++f)
+    if (build.sm.file(f).path == src.name) gen = f;
+  if (gen == UINT32_MAX) return;
+  std::string e;
+  if (!build.sm.load(reqs.path, &yaml, &e)) return;
+  // DiagEngine keeps its diagnostics; rewrite their locations in place.
+  auto& diags = const_cast<std::vector<st::Diagnostic>&>(build.diags.all());
+  for (auto& d : diags) {
+    if (d.loc.file != gen || d.loc.line == 0 || d.loc.line > src.lines.size()) continue;
+    const auto& li = src.lines[d.loc.line - 1];
+    if (!li.formula || li.formula->line == 0) {
+      d.message += " (in a default formula)";
+      continue;
+    }
+    uint32_t col = d.loc.col > li.prefix ? d.loc.col - li.prefix - 1 : 0;
+    uint32_t src_col = col < li.pos_map.size() ? li.pos_map[col] : (li.pos_map.empty() ? 0 : li.pos_map.back() + 1);
+    d.loc = st::SourceLoc{yaml, li.formula->line, li.formula->col + src_col};
+  }
+}
+
+// ------------------------------------------------------------------ checking
+
+std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const RequirementsFile& reqs, std::string* err) {
+  auto set = std::make_unique<MonitorSet>();
+  for (size_t i = 0; i < reqs.requirements.size(); ++i) {
+    const auto& spec = reqs.requirements[i];
+    std::string name = program_name(i);
+    const st::ProgramInstance* inst = nullptr;
+    for (const auto& o : app.observers)
+      if (o.name == name) inst = &o;
+    if (!inst) {
+      *err = "monitor for requirement " + spec.id + " is missing from the build";
+      return nullptr;
+    }
+    Req r;
+    r.spec = &spec;
+    r.entry = inst->pou->entry;
+    r.commit = inst->pou->commit_entry;
+    r.addr = inst->addr;
+    for (int k = 0; k < 6; ++k) {
+      const st::Symbol* s = inst->pou->find_var(kOutputs[k]);
+      if (!s) {
+        *err = "monitor " + name + " lacks " + kOutputs[k];
+        return nullptr;
+      }
+      r.out[k].type = s->type;
+      r.out[k].addr = inst->addr + s->offset;
+      r.out[k].path = name + "." + kOutputs[k];
+    }
+    const st::Symbol* el = inst->pou->find_var("__elapsed");
+    r.elapsed.type = el->type;
+    r.elapsed.addr = inst->addr + el->offset;
+    const FormulaSource* fs[] = {&spec.trigger, &spec.invariant, &spec.final, &spec.delay, &spec.reaction, &spec.release};
+    for (const auto* f : fs) {
+      std::string up = st::canon(f->text);
+      if (up.find("PASSED") != std::string::npos) r.uses_passed = true;
+    }
+    r.verdict.id = spec.id;
+    r.verdict.text = spec.text;
+    r.verdict.severity = spec.severity;
+    set->reqs_.push_back(std::move(r));
+  }
+  return set;
+}
+
+bool MonitorSet::eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6]) {
+  st::write_int(m, r.elapsed, elapsed);
+  bool ok = m.call(r.entry, r.addr);
+  for (int k = 0; k < 6; ++k) v[k] = ok && m.mem()[r.out[k].addr] != 0;
+  return ok;
+}
+
+bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
+  newly_.clear();
+  for (size_t ri = 0; ri < reqs_.size(); ++ri) {
+    Req& r = reqs_[ri];
+    bool base[6];
+    eval(m, r, 0, base);
+    bool was_violated = r.verdict.violated();
+    if (base[0]) {
+      ++r.verdict.triggers;
+      r.groups.push_back(Group{false, state, t, state, t, 1});
+    }
+    auto violate = [&](const Group& g, Cause c) {
+      r.verdict.violated_instances += g.count;
+      if (r.verdict.violations.size() < Verdict::kMaxListed)
+        r.verdict.violations.push_back(Violation{g.first_trigger, g.first_trigger_time, state, t, c, g.count});
+    };
+    for (size_t gi = 0; gi < r.groups.size();) {
+      Group& g = r.groups[gi];
+      bool v[6];
+      bool done = false;
+      const bool* val = base;
+      if (r.uses_passed && !(g.timer_time == t)) {
+        eval(m, r, t - g.timer_time, v);
+        val = v;
+      }
+      if (!g.phase_b) {
+        if (val[5]) {
+          r.verdict.holds += g.count;
+          done = true;
+        } else if (val[2]) {
+          g.phase_b = true;
+          g.timer_state = state;
+          g.timer_time = t;
+          val = base;  // the timer point is now: elapsed 0
+        } else if (!val[1]) {
+          violate(g, Cause::Invariant);
+          done = true;
+        }
+      }
+      if (!done && g.phase_b) {
+        if (val[5] || val[4]) {
+          r.verdict.holds += g.count;
+          done = true;
+        } else if (!val[1]) {
+          violate(g, Cause::Invariant);
+          done = true;
+        } else if (val[3]) {
+          violate(g, Cause::Delay);
+          done = true;
+        }
+      }
+      if (done) r.groups.erase(r.groups.begin() + static_cast<long>(gi));
+      else ++gi;
+    }
+    // Instances that behave identically from now on are one group: without PASSED all
+    // instances of a phase; with PASSED those sharing their timer point.
+    if (r.groups.size() > 1) {
+      std::vector<Group> merged;
+      for (const auto& g : r.groups) {
+        auto it = std::find_if(merged.begin(), merged.end(), [&](const Group& x) {
+          return x.phase_b == g.phase_b && (!r.uses_passed || x.timer_time == g.timer_time);
+        });
+        if (it == merged.end()) merged.push_back(g);
+        else it->count += g.count;
+      }
+      r.groups.swap(merged);
+    }
+    m.call(r.commit, r.addr);
+    if (!was_violated && r.verdict.violated()) newly_.push_back(ri);
+  }
+  return !newly_.empty();
+}
+
+std::vector<Verdict> MonitorSet::verdicts() const {
+  std::vector<Verdict> out;
+  for (const auto& r : reqs_) {
+    Verdict v = r.verdict;
+    v.pending = 0;
+    for (const auto& g : r.groups) v.pending += g.count;
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+std::string cause_text(Cause c) {
+  return c == Cause::Invariant ? "invariant broken" : "no reaction within the delay";
+}
+
+std::string format_verdicts(const std::vector<Verdict>& verdicts, int64_t) {
+  std::string out;
+  size_t violated = 0;
+  for (const auto& v : verdicts) {
+    violated += v.violated();
+    out += fmt::format("{:<10} {}  {}\n", v.id, v.violated() ? "VIOLATED " : "SATISFIED", v.text);
+    out += fmt::format("           triggers {}, held {}, violated {}, pending {}\n", v.triggers, v.holds, v.violated_instances,
+                       v.pending);
+    for (const auto& x : v.violations)
+      out += fmt::format("           - trigger at state {} (t={:.3f} s), violated at state {} (t={:.3f} s): {}{}\n",
+                         x.trigger_state, static_cast<double>(x.trigger_time_ns) * 1e-9, x.state,
+                         static_cast<double>(x.time_ns) * 1e-9, cause_text(x.cause),
+                         x.instances > 1 ? fmt::format(" ({} instances)", x.instances) : "");
+    if (v.violated_instances > v.violations.size() && v.violations.size() == Verdict::kMaxListed)
+      out += "           (further violations not listed)\n";
+  }
+  out += fmt::format("{} requirement(s): {} satisfied, {} violated\n", verdicts.size(), verdicts.size() - violated, violated);
+  return out;
+}
+
+}  // namespace plcfi::monitor
