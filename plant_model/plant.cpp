@@ -1,0 +1,24 @@
+// Plant factory: maps a plant name and an optional parameter file to a plant model.
+#include "plant_model/plant.hpp"
+
+#include "plant_model/stamping/stamping_plant.hpp"
+
+namespace plcfi::plant {
+
+std::unique_ptr<Plant> make_plant(const std::string& name, const std::string& config_path, std::string* err) {
+  if (name == "stamping") {
+    StampingParams params;
+    if (!config_path.empty() && !load_stamping_params(config_path, &params, err)) return nullptr;
+    return std::make_unique<StampingPlant>(std::move(params));
+  }
+  if (err) {
+    std::string known;
+    for (const auto& n : plant_names()) known += (known.empty() ? "" : ", ") + n;
+    *err = "unknown plant '" + name + "' (known: " + known + ")";
+  }
+  return nullptr;
+}
+
+std::vector<std::string> plant_names() { return {"stamping"}; }
+
+}  // namespace plcfi::plant
