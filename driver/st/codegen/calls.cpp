@@ -285,10 +285,17 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
 
 // ------------------------------------------------------------------ FB instances
 
-Val Compiler::call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of) {
+Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouInfo* body_of) {
   Val none;
   none.type = elem(TypeKind::Void);
   if (!fb) return bad();
+  Place inst = inst_in;
+  if (inst.k == Place::K::FrameIdx) {
+    // An element of an instance array: call through its address.
+    inst.k = Place::K::Ind;
+    inst.ptr = addr_of(inst_in, c.loc);
+    inst.off = 0;
+  }
   std::vector<std::pair<Symbol*, const CallArg*>> outs;
   std::vector<Symbol*> params;
   for (PouInfo* f = fb; f; f = f->base) {

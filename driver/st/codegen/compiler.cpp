@@ -145,6 +145,10 @@ bool Compiler::retarget(Slot from, Slot to) {
 
 void Compiler::emit_list(Op op, const std::vector<Arg>& args) {
   auto& code = b_->code;
+  // A call may change any variable: cached conversions are stale after it; so are they
+  // after a store into a variable (the cache holds conversions of variables).
+  if (op == Op::CALL || op == Op::CALLA || op == Op::CALLP || op == Op::CALLS || op == Op::CALLV || op == Op::NATIVE)
+    b_->cvt_cache.clear();
   b_->last_instr = static_cast<uint32_t>(code.size());
   code.push_back(static_cast<uint32_t>(op));
   for (const Arg& a : args) {
@@ -373,7 +377,16 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   }
 
   uint32_t base = static_cast<uint32_t>(app_->code.size());
-  for (auto [idx, label] : b.target_fix) b.code[idx] = base + b.label_pos[label];
+  for (auto [idx, label] : b.target_fix) {
+    // Jump threading: a jump to an unconditional jump goes straight to its target.
+    uint32_t target = b.label_pos[label];
+    for (int hops = 0; hops < 8 && target < b.code.size() && b.code[target] == static_cast<uint32_t>(Op::JMP); ++hops) {
+      auto it = std::find_if(b.target_fix.begin(), b.target_fix.end(), [&](const auto& f) { return f.first == target + 1; });
+      if (it == b.target_fix.end()) break;
+      target = b.label_pos[it->second];
+    }
+    b.code[idx] = base + target;
+  }
   for (auto [idx, pou] : b.entry_fix) entry_fix_.emplace_back(base + idx, pou);
   for (auto [pc, loc] : b.lines) app_->lines.emplace_back(base + pc, loc);
   app_->code.insert(app_->code.end(), b.code.begin(), b.code.end());

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <map>
+#include <tuple>
 #include <memory>
 #include <optional>
 #include <string>
@@ -80,6 +81,8 @@ struct Place {
   Slot idx;           // FrameIdx: DINT index slot
   int32_t lo = 0;     // FrameIdx
   uint32_t count = 0; // FrameIdx
+  uint32_t stride = 0;  // FrameIdx: element size (0: the value's own size, an array of scalars)
+  uint32_t field = 0;   // FrameIdx: offset of the scalar inside the element
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -112,6 +115,8 @@ struct Body {
   Slot last_def;
   uint32_t last_label_pos = 0;
   uint32_t last_instr = UINT32_MAX;
+  // Conversions already done in the statement being compiled (an index used twice).
+  std::map<std::tuple<uint32_t, SK, Storage, Storage>, Slot> cvt_cache;
   std::unordered_map<std::string, Symbol*> locals;  // canon name -> symbol (frame or This)
   bool is_method = false;
   const Type* this_type = nullptr;  // FB type whose members are reachable (body or method)

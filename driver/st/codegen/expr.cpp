@@ -369,6 +369,18 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
   p.type = f->type;
   switch (base.k) {
     case Place::K::Frame: case Place::K::Abs: case Place::K::Ind: p.off = base.off + f->offset; break;
+    case Place::K::FrameIdx:
+      if (!f->type->is_elementary()) {
+        // Deeper selection: go through the element's address.
+        Place ind;
+        ind.k = Place::K::Ind;
+        ind.type = base.type;
+        ind.ptr = addr_of(base, loc);
+        ind.readonly = base.readonly;
+        return member_place(ind, member, loc);
+      }
+      p.field = base.field + f->offset;
+      break;
     default:
       diags_.error("ST207", loc, "member access on this expression is not supported");
       return bad_place;
@@ -435,9 +447,11 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     if (base.k == Place::K::AbsBit || base.k == Place::K::Bit || base.k == Place::K::FrameIdx) return bad_place;
     return p;
   }
-  // Fast path: one variable index into a frame array of scalars.
-  if (dyn.size() == 1 && base.k == Place::K::Frame && t->elem->is_elementary() &&
-      (esize == 1 || esize == 2 || esize == 4 || esize == 8) && t->dims.size() == 1) {
+  // Fast path: one variable index into a frame array of scalars or of structures (whose
+  // scalar fields are then reached in one instruction).
+  if (dyn.size() == 1 && base.k == Place::K::Frame && t->dims.size() == 1 &&
+      ((t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) || t->elem->kind == TypeKind::Struct ||
+       t->elem->kind == TypeKind::Pou)) {
     Place p;
     p.k = Place::K::FrameIdx;
     p.type = t->elem;
@@ -446,6 +460,7 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     p.idx = dyn[0].second;
     p.lo = static_cast<int32_t>(t->dims[0].lo);
     p.count = static_cast<uint32_t>(t->dims[0].hi - t->dims[0].lo + 1);
+    p.stride = t->elem->is_elementary() ? 0 : esize;
     p.readonly = base.readonly;
     return p;
   }
@@ -499,8 +514,11 @@ Slot Compiler::addr_of(const Place& p, SourceLoc loc) {
       Slot a = temp(4, 4);
       emit(Op::ADDR, {a, Slot{p.off, p.sk}});
       Slot t = temp(4, 4);
-      emit(Op::ELEM, {t, a, p.idx, static_cast<uint32_t>(p.lo), p.count, p.type->size});
-      return t;
+      emit(Op::ELEM, {t, a, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride ? p.stride : p.type->size});
+      if (p.field == 0) return t;
+      Slot f = temp(4, 4);
+      emit(Op::ADDRI, {f, t, p.field});
+      return f;
     }
     default:
       diags_.error("ST232", loc, "cannot take the address of a single bit");
@@ -514,6 +532,13 @@ Val Compiler::load(const Place& p) {
   Val v;
   v.type = p.type;
   if (!p.ok) return bad();
+  if (p.k == Place::K::FrameIdx && !p.type->is_elementary()) {
+    Place ind = p;
+    ind.k = Place::K::Ind;
+    ind.ptr = addr_of(p, SourceLoc{});
+    ind.off = 0;
+    return load(ind);
+  }
   uint32_t size = p.type->size;
   switch (p.k) {
     case Place::K::Frame: v.slot = Slot{p.off, p.sk}; return v;
@@ -552,8 +577,13 @@ Val Compiler::load(const Place& p) {
     }
     case Place::K::FrameIdx: {
       Slot t = temp_for(p.type);
-      Op op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
-      emit(op, {t, Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count});
+      if (p.stride) {
+        Op op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
+        emit(op, {t, Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+      } else {
+        Op op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
+        emit(op, {t, Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count});
+      }
       def(t);
       v.slot = t;
       return v;
@@ -574,6 +604,14 @@ Val Compiler::load(const Place& p) {
 
 void Compiler::store(const Place& p, Slot src) {
   const Type* t = p.type;
+  if (p.k == Place::K::FrameIdx && !t->is_elementary()) {
+    Place ind = p;
+    ind.k = Place::K::Ind;
+    ind.ptr = addr_of(p, SourceLoc{});
+    ind.off = 0;
+    store(ind, src);
+    return;
+  }
   uint32_t size = t->size;
   if (t->is_string() && p.k == Place::K::Frame) {
     emit(Op::SCPY, {Slot{p.off, p.sk}, src, t->str_len});
@@ -612,6 +650,11 @@ void Compiler::store(const Place& p, Slot src) {
         default: emit(Op::STIN, {p.ptr, p.off, src, size}); return;
       }
     case Place::K::FrameIdx: {
+      if (p.stride) {
+        Op op = size == 1 ? Op::STXS1 : size == 2 ? Op::STXS2 : size == 4 ? Op::STXS4 : Op::STXS8;
+        emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        return;
+      }
       Op op = size == 1 ? Op::STX1 : size == 2 ? Op::STX2 : size == 4 ? Op::STX4 : Op::STX8;
       emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, src});
       return;
@@ -702,9 +745,15 @@ Slot Compiler::convert(Slot s, const Type* from, const Type* to) {
   auto is_int = [](Storage x) { return x != Storage::F32 && x != Storage::F64; };
   static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8, 4, 8};
   if (is_int(a) && is_int(b) && kWidth[storage_index(a)] == kWidth[storage_index(b)]) return s;
+  auto key = std::make_tuple(s.off, s.kind, a, b);
+  if (s.kind == SK::Var) {
+    auto it = b_->cvt_cache.find(key);
+    if (it != b_->cvt_cache.end()) return it->second;
+  }
   Slot t = temp_for(to);
   emit(cvt_op(a, b), {t, s});
   def(t);
+  if (s.kind == SK::Var) b_->cvt_cache[key] = t;
   return t;
 }
 

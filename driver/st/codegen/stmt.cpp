@@ -19,6 +19,24 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
   // Peephole: "CMP t, a, b; JMPF target, t" -> "J<inverse> target, a, b".
   auto& code = b_->code;
   uint32_t at = b_->last_instr;
+  if (at >= code.size()) {
+    emit(when_true ? Op::JMPT : Op::JMPF, {Arg::target(target.id), cs});
+    return;
+  }
+  if (!c.is_const && b_->last_def_pos == at && b_->last_label_pos <= at && code[at] == static_cast<uint32_t>(Op::BNOT) &&
+      b_->last_def.kind == cs.kind && b_->last_def.off == cs.off && cs.kind == SK::Temp) {
+    // "BNOT t, x; JMPF target, t" -> "JMPT target, x".
+    Arg x(code[at + 2]);
+    for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
+      if (it->first == at + 2) x = Arg(Slot{code[at + 2], it->second});
+      if (it->first >= at) it = b_->slot_fix.erase(it);
+      else ++it;
+    }
+    code.resize(at);
+    emit(when_true ? Op::JMPF : Op::JMPT, {Arg::target(target.id), x});
+    b_->last_def_pos = UINT32_MAX;
+    return;
+  }
   if (!c.is_const && b_->last_def_pos == at && b_->last_label_pos <= at && b_->last_def_operand == 1 &&
       b_->last_def.kind == cs.kind && b_->last_def.off == cs.off && cs.kind == SK::Temp) {
     uint32_t op = code[at];
@@ -78,6 +96,7 @@ void Compiler::stmts(const StmtList& list) {
 
 void Compiler::stmt(const Stmt& s) {
   uint32_t saved_top = b_->temp_top;
+  b_->cvt_cache.clear();
   mark(s.loc);
   switch (s.kind) {
     case StmtKind::Assign: assign_stmt(static_cast<const AssignStmt&>(s)); break;
@@ -113,6 +132,7 @@ void Compiler::stmt(const Stmt& s) {
       break;
     }
     case StmtKind::MockFunction: {
+      b_->cvt_cache.clear();
       const auto& m = static_cast<const MockFunctionStmt&>(s);
       if (!opt_.test_mode) {
         diags_.error("ST234", s.loc, "MOCK_FUNCTION is only allowed in test files");
@@ -148,6 +168,7 @@ void Compiler::stmt(const Stmt& s) {
     }
   }
   b_->temp_top = saved_top;
+  b_->cvt_cache.clear();
 }
 
 void Compiler::assign_stmt(const AssignStmt& s) {
@@ -412,9 +433,10 @@ void Compiler::for_stmt(const ForStmt& s) {
     // Skip the loop when the range is empty.
     if (down) emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), iv, limit});
     else emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), limit, iv});
+    // Coverage records that the body ran, once per entry into the loop, not per iteration.
+    branch(s.loc, "FOR");
     bind(body);
     b_->loops.push_back({exit, cont});
-    branch(s.loc, "FOR");
     stmts(s.body);
     b_->loops.pop_back();
     bind(cont);

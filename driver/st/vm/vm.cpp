@@ -173,7 +173,7 @@ bool Machine::fail(TrapKind k, const uint32_t* pc, std::string msg) {
 }
 
 bool Machine::call(uint32_t entry, uint32_t base_addr) {
-  trap_ = Trap{};
+  trap_.kind = TrapKind::None;  // the message is only meaningful after a failed call
   if (entry >= app_->code.size() || base_addr > mem_.size())
     return fail(TrapKind::BadAddress, app_->code.data(), "entry or base outside the application");
   return run(app_->code.data() + entry, mem_.data() + base_addr);
@@ -541,6 +541,31 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   LDX_IMPL(4, uint32_t)
   LDX_IMPL(8, uint64_t)
 #undef LDX_IMPL
+
+#define LDXS_IMPL(N, T)                                                                        \
+  L_LDXS##N: {                                                                                 \
+    int64_t i = static_cast<int64_t>(R(int32_t, 3)) - static_cast<int32_t>(pc[4]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int32_t, 3), static_cast<int32_t>(pc[4]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
+    W(T, 1, ld<T>(base + pc[2] + i * pc[6] + pc[7]));                                          \
+    NEXT(7);                                                                                   \
+  }                                                                                            \
+  L_STXS##N: {                                                                                 \
+    int64_t i = static_cast<int64_t>(R(int32_t, 2)) - static_cast<int32_t>(pc[3]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int32_t, 2), static_cast<int32_t>(pc[3]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
+    st<T>(base + pc[1] + i * pc[5] + pc[6], R(T, 7));                                          \
+    NEXT(7);                                                                                   \
+  }
+  LDXS_IMPL(1, uint8_t)
+  LDXS_IMPL(2, uint16_t)
+  LDXS_IMPL(4, uint32_t)
+  LDXS_IMPL(8, uint64_t)
+#undef LDXS_IMPL
 
 #undef DISPATCH
 #undef NEXT
