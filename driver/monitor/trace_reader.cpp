@@ -176,6 +176,8 @@ class VcdReader final : public TraceReader {
         else if (width == "1") col.kind = TraceColumn::Kind::Bool;
         ids_[id] = columns_.size();
         columns_.push_back(col);
+        widths_.push_back(static_cast<size_t>(std::strtoul(width.c_str(), nullptr, 10)));
+        signed_.push_back(kind == "integer");
         skip_end();
       } else if (tok == "$timescale") {
         std::string ts;
@@ -305,9 +307,13 @@ class VcdReader final : public TraceReader {
       } else {
         uint64_t bits = 0;
         for (char ch : value) bits = (bits << 1) | (ch == '1' ? 1u : 0u);
-        // Integers are two's complement of the declared width; plcfi writes the full width.
-        if (columns_[it->second].kind == TraceColumn::Kind::Int && value.size() > 1 && value[0] == '1' && value.size() < 64)
-          v = static_cast<double>(static_cast<int64_t>(bits) - (static_cast<int64_t>(1) << value.size()));
+        // A shorter value is zero-extended (VCD); a signed "integer" that fills its width
+        // with a leading 1 is negative (two's complement).
+        size_t width = widths_[it->second];
+        if (signed_[it->second] && value.size() == width && value[0] == '1' && width > 1 && width < 64)
+          v = static_cast<double>(static_cast<int64_t>(bits) - (static_cast<int64_t>(1) << width));
+        else if (signed_[it->second] && value.size() == 64 && width == 64)
+          v = static_cast<double>(static_cast<int64_t>(bits));
         else
           v = static_cast<double>(bits);
       }
@@ -324,6 +330,8 @@ class VcdReader final : public TraceReader {
   int64_t cycle_ns_ = 0, timescale_ = 1;
   size_t line_ = 1;
   std::map<std::string, size_t> ids_;
+  std::vector<size_t> widths_;
+  std::vector<bool> signed_;
   std::vector<double> cur_;
   int64_t pending_t_ = 0, next_change_t_ = 0, sample_t_ = 0, last_t_ = 0;
   bool started_ = false, ended_ = false;

@@ -96,8 +96,10 @@ class VcdWriter final : public TraceWriter {
       kinds_.push_back(kind);
       uint32_t width = kind == VcdKind::Wire ? 1 : kind == VcdKind::Real ? 64 : h.type->size * 8;
       widths_.push_back(width);
-      sink_.put(fmt::format("$var {} {} {} {} $end\n", kind == VcdKind::Wire ? "wire" : kind == VcdKind::Real ? "real" : "integer",
-                            width, ids_.back(), leaf));
+      // Signed integers are VCD "integer"; unsigned ones and bit strings "reg".
+      const char* vtype = kind == VcdKind::Wire ? "wire" : kind == VcdKind::Real ? "real"
+                          : (h.type->is_signed() || h.type->is_time_like() || h.type->kind == st::TypeKind::Enum) ? "integer" : "reg";
+      sink_.put(fmt::format("$var {} {} {} {} $end\n", vtype, width, ids_.back(), leaf));
     }
     while (!open_scopes.empty()) {
       sink_.put("$upscope $end\n");
