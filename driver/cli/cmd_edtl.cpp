@@ -7,7 +7,6 @@
 #include "commands.hpp"
 #include "engine.hpp"
 #include "monitor/edtl.hpp"
-#include "monitor/trace_reader.hpp"
 #include "report/junit.hpp"
 #include "runtime/schedule.hpp"
 
@@ -112,55 +111,13 @@ int cmd_edtl(const std::vector<std::string>& args) {
     std::cerr << err << "\n";
     return 2;
   }
-  bool is_vcd = files[1].size() > 4 && files[1].substr(files[1].size() - 4) == ".vcd";
-  auto reader = monitor::TraceReader::open(files[1], cycle ? cycle : (is_vcd ? 0 : 1'000'000'000), &err);
-  if (!reader) {
-    std::cerr << err << "\n";
+  monitor::TraceCheck result;
+  if (!monitor::check_trace(reqs, files[1], cycle, &result, &err)) {
+    std::cerr << err << (err.empty() || err.back() == '\n' ? "" : "\n");
     return 2;
   }
-  std::string program;
-  if (!monitor::trace_program(reader->columns(), &program, &err)) {
-    std::cerr << files[1] << ": " << err << "\n";
-    return 2;
-  }
-  auto mon = monitor::generate_monitors(reqs);
-  st::CompileOptions opt;
-  opt.warnings = false;
-  auto b = st::build_sources({{"<trace:" + files[1] + ">", program}}, opt, {{mon.name, mon.text}});
-  monitor::remap_diagnostics(*b, mon, reqs);
-  std::cerr << b->diags.render_all();
-  if (!b->ok()) return 2;
-  auto set = monitor::MonitorSet::create(*b->app, reqs, &err);
-  if (!set) {
-    std::cerr << "plcfi edtl check: " << err << "\n";
-    return 2;
-  }
-  st::Machine m(*b->app);
-  std::vector<st::VarHandle> handles;
-  for (const auto& c : reader->columns()) {
-    auto h = st::resolve(*b->app, c.name, &err);
-    if (!h) {
-      std::cerr << files[1] << ": column " << c.name << ": " << err << "\n";
-      return 2;
-    }
-    handles.push_back(*h);
-  }
-  std::vector<double> values;
-  int64_t t = 0;
-  uint64_t state = 0;
-  while (reader->next(&t, &values, &err)) {
-    for (size_t i = 0; i < handles.size(); ++i) {
-      if (handles[i].type->is_real()) st::write_real(m, handles[i], values[i]);
-      else st::write_int(m, handles[i], static_cast<int64_t>(values[i]));
-    }
-    m.set_now(t);
-    set->step(m, state++, t);
-  }
-  if (!err.empty()) {
-    std::cerr << err << "\n";
-    return 2;
-  }
-  auto verdicts = set->verdicts();
+  uint64_t state = result.states;
+  const auto& verdicts = result.verdicts;
   if (vm.count("json")) {
     std::cout << fmt::format("{{\"trace\": \"{}\", \"states\": {}, \"requirements\": {}}}\n", json_escape(files[1]), state,
                              verdicts_json(verdicts));

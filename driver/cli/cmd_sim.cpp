@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "engine.hpp"
 #include "io/sim/sim_backend.hpp"
+#include "monitor/edtl.hpp"
 #include "plant_model/plant.hpp"
 #include "report/trace.hpp"
 #include "runtime/runtime.hpp"
@@ -72,6 +73,26 @@ class AlarmWatch final : public rt::ScanHooks {
   std::vector<uint64_t> rises_;
 };
 
+// Checks the requirements once per scan and reports each first violation as it happens.
+class MonitorHook final : public rt::ScanHooks {
+ public:
+  explicit MonitorHook(monitor::MonitorSet* set) : set_(set) {}
+  void end_of_scan(rt::Runtime& r) override {
+    if (!set_->step(r.machine(), r.scan_count(), r.now())) return;
+    auto verdicts = set_->verdicts();
+    for (size_t i : set_->newly_violated()) {
+      const auto& v = verdicts[i];
+      const auto& x = v.violations.front();
+      std::cout << fmt::format("  [scan {}, t={:.3f} s] {} VIOLATED: {} (trigger at scan {}, t={:.3f} s){}\n", x.state,
+                               static_cast<double>(x.time_ns) * 1e-9, v.id, monitor::cause_text(x.cause), x.trigger_state,
+                               static_cast<double>(x.trigger_time_ns) * 1e-9, v.text.empty() ? "" : " - " + v.text);
+    }
+  }
+
+ private:
+  monitor::MonitorSet* set_;
+};
+
 class TraceHook final : public rt::ScanHooks {
  public:
   explicit TraceHook(std::vector<report::TraceWriter*> w) : writers_(std::move(w)) {}
@@ -104,7 +125,8 @@ int cmd_sim(const std::vector<std::string>& args) {
       ("vcd", po::value<std::string>(), "write a VCD trace")
       ("csv", po::value<std::string>(), "write a CSV trace (one row per scan)")
       ("watch", po::value<std::vector<std::string>>(), "variables to trace, comma-separated (default: the plant's signals and the alarms)")
-      ("alarms", po::value<std::vector<std::string>>(), "alarm variables to report (default: BOOL globals named *Error*, *Alarm*, *Warning*, *Stop*, *Fault*)");
+      ("alarms", po::value<std::vector<std::string>>(), "alarm variables to report (default: BOOL globals named *Error*, *Alarm*, *Warning*, *Stop*, *Fault*)")
+      ("requirements", po::value<std::string>(), "EDTL requirements (YAML) checked every scan");
   desc.add_options()("help,h", "show this help");
   po::options_description all;
   all.add(desc);
@@ -116,7 +138,7 @@ int cmd_sim(const std::vector<std::string>& args) {
   po::notify(vm);
   if (vm.count("help")) {
     std::cout << "usage: plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
-                 "[--vcd F] [--csv F] [--watch PATH,...]\n\n"
+                 "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml]\n\n"
               << desc << "\n";
     return 0;
   }
@@ -128,15 +150,26 @@ int cmd_sim(const std::vector<std::string>& args) {
     std::cerr << "plcfi sim: no program files (--program FILE...)\n";
     return 2;
   }
+  std::string err;
+  monitor::RequirementsFile reqs;
+  monitor::MonitorSource mon;
+  st::NamedSources late;
+  if (vm.count("requirements")) {
+    if (!monitor::load_requirements(vm["requirements"].as<std::string>(), &reqs, &err)) {
+      std::cerr << err << "\n";
+      return 2;
+    }
+    mon = monitor::generate_monitors(reqs);
+    late.emplace_back(mon.name, mon.text);
+  }
   st::CompileOptions opt;
   opt.warnings = false;
-  auto b = st::build_files(files, opt);
+  auto b = st::build_files(files, opt, late);
   for (const auto& e : b->io_errors) std::cerr << e << "\n";
+  if (!late.empty()) monitor::remap_diagnostics(*b, mon, reqs);
   std::cerr << b->diags.render_all();
   if (!b->ok()) return 2;
   const st::Application& app = *b->app;
-
-  std::string err;
   int64_t duration = 0, cycle = 0;
   if (!rt::parse_duration(vm["duration"].as<std::string>(), &duration, &err) || duration <= 0) {
     std::cerr << "plcfi sim: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
@@ -229,6 +262,18 @@ int cmd_sim(const std::vector<std::string>& args) {
   TraceHook trace(raw);
   if (!raw.empty()) runtime.add_hooks(&trace);
 
+  std::unique_ptr<monitor::MonitorSet> monitors;
+  std::unique_ptr<MonitorHook> monitor_hook;
+  if (!late.empty()) {
+    monitors = monitor::MonitorSet::create(app, reqs, &err);
+    if (!monitors) {
+      std::cerr << "plcfi sim: " << err << "\n";
+      return 2;
+    }
+    monitor_hook = std::make_unique<MonitorHook>(monitors.get());
+    runtime.add_hooks(monitor_hook.get());
+  }
+
   uint64_t seed = vm["seed"].as<uint64_t>();
   runtime.cold_restart(seed);
   uint64_t scans = static_cast<uint64_t>(duration / sched.tick_ns());
@@ -253,11 +298,18 @@ int cmd_sim(const std::vector<std::string>& args) {
   for (const auto& [k, v] : backend->plant().stats()) stats += fmt::format("{}{} {}", stats.empty() ? "" : ", ", k, v);
   std::cout << "  plant           " << stats << "\n";
   std::cout << "  alarms raised   " << alarm_watch.summary() << "\n";
+  int status = 0;
+  if (monitors) {
+    auto verdicts = monitors->verdicts();
+    std::cout << "requirements (" << vm["requirements"].as<std::string>() << "):\n" << monitor::format_verdicts(verdicts);
+    for (const auto& v : verdicts)
+      if (v.violated()) status = 1;
+  }
   if (!trap_text.empty()) {
     std::cout << "  program stopped " << trap_text << "\n";
     return 1;
   }
-  return 0;
+  return status;
 }
 
 }  // namespace plcfi::cli

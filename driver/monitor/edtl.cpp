@@ -8,6 +8,8 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "trace_reader.hpp"
+
 namespace plcfi::monitor {
 
 // ------------------------------------------------------------------ loading
@@ -403,6 +405,55 @@ std::string format_verdicts(const std::vector<Verdict>& verdicts, int64_t) {
   }
   out += fmt::format("{} requirement(s): {} satisfied, {} violated\n", verdicts.size(), verdicts.size() - violated, violated);
   return out;
+}
+
+bool check_trace(const RequirementsFile& reqs, const std::string& trace_path, int64_t cycle_ns, TraceCheck* out,
+                 std::string* error) {
+  bool is_vcd = trace_path.size() > 4 && trace_path.substr(trace_path.size() - 4) == ".vcd";
+  auto reader = TraceReader::open(trace_path, cycle_ns ? cycle_ns : (is_vcd ? 0 : 1'000'000'000), error);
+  if (!reader) return false;
+  std::string program;
+  if (!trace_program(reader->columns(), &program, error)) {
+    *error = trace_path + ": " + *error;
+    return false;
+  }
+  auto mon = generate_monitors(reqs);
+  st::CompileOptions opt;
+  opt.warnings = false;
+  auto b = st::build_sources({{"<trace:" + trace_path + ">", program}}, opt, {{mon.name, mon.text}});
+  remap_diagnostics(*b, mon, reqs);
+  if (!b->ok()) {
+    *error = b->diags.render_all();
+    return false;
+  }
+  auto set = MonitorSet::create(*b->app, reqs, error);
+  if (!set) return false;
+  st::Machine m(*b->app);
+  std::vector<st::VarHandle> handles;
+  for (const auto& c : reader->columns()) {
+    auto h = st::resolve(*b->app, c.name, error);
+    if (!h) {
+      *error = trace_path + ": column " + c.name + ": " + *error;
+      return false;
+    }
+    handles.push_back(*h);
+  }
+  std::vector<double> values;
+  int64_t t = 0;
+  uint64_t state = 0;
+  error->clear();
+  while (reader->next(&t, &values, error)) {
+    for (size_t i = 0; i < handles.size(); ++i) {
+      if (handles[i].type->is_real()) st::write_real(m, handles[i], values[i]);
+      else st::write_int(m, handles[i], static_cast<int64_t>(values[i]));
+    }
+    m.set_now(t);
+    set->step(m, state++, t);
+  }
+  if (!error->empty()) return false;
+  out->verdicts = set->verdicts();
+  out->states = state;
+  return true;
 }
 
 }  // namespace plcfi::monitor

@@ -123,6 +123,16 @@ class MonitorSet {
 };
 
 std::string format_verdicts(const std::vector<Verdict>& v, int64_t cycle_ns = 0);
+
+// Offline: checks requirements on a CSV/VCD trace. cycle_ns: time between states when the
+// trace has no time column (CSV default 1 s), or the VCD sampling period (0: one state per
+// time stamp). On failure returns false with the rendered diagnostics or error in *error.
+struct TraceCheck {
+  std::vector<Verdict> verdicts;
+  uint64_t states = 0;
+};
+bool check_trace(const RequirementsFile& reqs, const std::string& trace_path, int64_t cycle_ns, TraceCheck* out,
+                 std::string* error);
 std::string cause_text(Cause c);
 
 }  // namespace plcfi::monitor

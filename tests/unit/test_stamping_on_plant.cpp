@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "engine.hpp"
 #include "io/sim/sim_backend.hpp"
+#include "monitor/edtl.hpp"
 #include "monitor/trace_reader.hpp"
 #include "plant_model/plant.hpp"
 #include "report/trace.hpp"
@@ -24,8 +26,8 @@ struct Cell {
   std::unique_ptr<io::SimBackend> backend;
   std::unique_ptr<rt::Runtime> runtime;
 
-  explicit Cell(const std::string& program, uint64_t seed = 1) {
-    build = st::build_files({program_path(program)}, st::CompileOptions{});
+  explicit Cell(const std::string& program, uint64_t seed = 1, const st::NamedSources& late = {}) {
+    build = st::build_files({program_path(program)}, st::CompileOptions{}, late);
     EXPECT_TRUE(build->ok()) << build->diags.render_all();
     std::string err;
     auto plant = plant::make_plant("stamping", "", &err);
@@ -203,6 +205,88 @@ TEST(StampingPlant, VcdTraceReadsBack) {
   EXPECT_EQ(rises, vrises);
   EXPECT_EQ(max_pressure, vmax);
   std::filesystem::remove(path);
+}
+
+// Online (a hook in the scan) and offline (on the CSV trace of the same run), one
+// requirement gives one verdict.
+class MonitorAndTrace final : public rt::ScanHooks {
+ public:
+  MonitorAndTrace(monitor::MonitorSet* set, report::TraceWriter* csv) : set_(set), csv_(csv) {}
+  void end_of_scan(rt::Runtime& r) override {
+    set_->step(r.machine(), r.scan_count(), r.now());
+    csv_->sample(r.now(), r.machine());
+  }
+
+ private:
+  monitor::MonitorSet* set_;
+  report::TraceWriter* csv_;
+};
+
+TEST(StampingPlant, RequirementsGiveTheSameVerdictOnlineAndOffline) {
+  auto dir = std::filesystem::temp_directory_path();
+  auto reqs_path = (dir / "plcfi_test_reqs.yaml").string();
+  auto csv_path = (dir / "plcfi_test_trace.csv").string();
+  {
+    std::ofstream f(reqs_path);
+    f << "requirements:\n"
+         "  - id: EXTEND\n    trigger: \"/Filled\"\n    delay: \"PASSED(T#500ms)\"\n    reaction: \"PosStamp\"\n"
+         "  - id: PRESS\n    trigger: \"/StampDown AND PressureSetpoint = 6000\"\n    delay: \"PASSED(T#500ms)\"\n"
+         "    reaction: \"StampLowered AND StampPressure >= 5700\"\n"
+         "  - id: TOO_FAST\n    trigger: \"/StampDown AND PressureSetpoint = 6000\"\n    delay: \"PASSED(T#100ms)\"\n    reaction: \"StampPressure >= 5700\"\n"
+         "  - id: RAISE\n    trigger: \"\\\\StampDown\"\n    invariant: \"NOT StampDown\"\n    delay: \"PASSED(T#300ms)\"\n"
+         "    reaction: \"StampUp\"\n"
+         "  - id: HOLD\n    trigger: \"/StampLowered\"\n    invariant: \"StampLowered\"\n    final: \"PASSED(T#1s)\"\n"
+         "    delay: \"PASSED(T#2s)\"\n    reaction: \"NOT StampLowered\"\n";
+  }
+  monitor::RequirementsFile reqs;
+  std::string err;
+  ASSERT_TRUE(monitor::load_requirements(reqs_path, &reqs, &err)) << err;
+  auto mon = monitor::generate_monitors(reqs);
+  Cell c("stamping.st", 3, {{mon.name, mon.text}});
+  ASSERT_TRUE(c.build->ok()) << c.build->diags.render_all();
+  auto set = monitor::MonitorSet::create(*c.build->app, reqs, &err);
+  ASSERT_TRUE(set) << err;
+  std::vector<st::VarHandle> vars;
+  for (const char* p : {"Filled", "PosStamp", "StampDown", "StampLowered", "StampUp", "StampPressure", "PressureSetpoint"}) {
+    auto h = st::resolve(*c.build->app, p, &err);
+    ASSERT_TRUE(h) << err;
+    vars.push_back(*h);
+  }
+  auto csv = report::open_csv(csv_path, vars, &err);
+  ASSERT_TRUE(csv) << err;
+  MonitorAndTrace hook(set.get(), csv.get());
+  c.runtime->add_hooks(&hook);
+  c.run_for(60);
+  ASSERT_TRUE(csv->close(&err)) << err;
+  auto online = set->verdicts();
+  monitor::TraceCheck offline;
+  ASSERT_TRUE(monitor::check_trace(reqs, csv_path, 0, &offline, &err)) << err;
+  EXPECT_EQ(6000u, offline.states);
+  ASSERT_EQ(online.size(), offline.verdicts.size());
+  for (size_t i = 0; i < online.size(); ++i) {
+    const auto& a = online[i];
+    const auto& b = offline.verdicts[i];
+    SCOPED_TRACE(a.id);
+    EXPECT_GT(a.triggers, 0u);
+    EXPECT_EQ(a.violated(), b.violated());
+    EXPECT_EQ(a.triggers, b.triggers);
+    EXPECT_EQ(a.holds, b.holds);
+    EXPECT_EQ(a.violated_instances, b.violated_instances);
+    EXPECT_EQ(a.pending, b.pending);
+    ASSERT_EQ(a.violations.size(), b.violations.size());
+    for (size_t k = 0; k < a.violations.size(); ++k) {
+      EXPECT_EQ(a.violations[k].state, b.violations[k].state);
+      EXPECT_EQ(a.violations[k].trigger_state, b.violations[k].trigger_state);
+      EXPECT_EQ(a.violations[k].cause, b.violations[k].cause);
+    }
+  }
+  // The plant needs about 0.45 s to reach the pressure: TOO_FAST (0.1 s) fails every stroke.
+  // (The reference stroke lowers the stamp without a setpoint: hence the setpoint in PRESS.)
+  EXPECT_TRUE(online[2].violated());
+  EXPECT_FALSE(online[0].violated());
+  EXPECT_FALSE(online[1].violated());
+  std::filesystem::remove(reqs_path);
+  std::filesystem::remove(csv_path);
 }
 
 }  // namespace
