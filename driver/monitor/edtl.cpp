@@ -205,7 +205,7 @@ MonitorSource generate_monitors(const RequirementsFile& reqs) {
   for (size_t i = 0; i < reqs.requirements.size(); ++i) {
     const auto& r = reqs.requirements[i];
     line("PROGRAM " + program_name(i));
-    line("VAR_INPUT __elapsed : LTIME; END_VAR");
+    line("VAR_INPUT __elapsed : LTIME; __state : LINT; END_VAR");
     line("VAR_OUTPUT __o_trig, __o_inv, __o_fin, __o_del, __o_react, __o_rel : BOOL; END_VAR");
     const FormulaSource* fs[] = {&r.trigger, &r.invariant, &r.final, &r.delay, &r.reaction, &r.release};
     for (int k = 0; k < 6; ++k) {
@@ -264,7 +264,6 @@ std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const
     Req r;
     r.spec = &spec;
     r.entry = inst->pou->entry;
-    r.commit = inst->pou->commit_entry;
     r.addr = inst->addr;
     for (int k = 0; k < 6; ++k) {
       const st::Symbol* s = inst->pou->find_var(kOutputs[k]);
@@ -277,8 +276,11 @@ std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const
       r.out[k].path = name + "." + kOutputs[k];
     }
     const st::Symbol* el = inst->pou->find_var("__elapsed");
+    const st::Symbol* sn = inst->pou->find_var("__state");
     r.elapsed.type = el->type;
     r.elapsed.addr = inst->addr + el->offset;
+    r.state.type = sn->type;
+    r.state.addr = inst->addr + sn->offset;
     const FormulaSource* fs[] = {&spec.trigger, &spec.invariant, &spec.final, &spec.delay, &spec.reaction, &spec.release};
     for (const auto* f : fs) {
       std::string up = st::canon(f->text);
@@ -294,6 +296,7 @@ std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const
 
 bool MonitorSet::eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6]) {
   st::write_int(m, r.elapsed, elapsed);
+  st::write_int(m, r.state, static_cast<int64_t>(state_));
   bool ok = m.call(r.entry, r.addr);
   for (int k = 0; k < 6; ++k) v[k] = ok && m.mem()[r.out[k].addr] != 0;
   return ok;
@@ -301,6 +304,7 @@ bool MonitorSet::eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6]) {
 
 bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
   newly_.clear();
+  state_ = state;
   for (size_t ri = 0; ri < reqs_.size(); ++ri) {
     Req& r = reqs_[ri];
     bool base[6];
@@ -354,19 +358,19 @@ bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
       else ++gi;
     }
     // Instances that behave identically from now on are one group: without PASSED all
-    // instances of a phase; with PASSED those sharing their timer point.
+    // instances of a phase; with PASSED those sharing their timer point. (In place: the
+    // vector's capacity is reused, no allocation per state.)
     if (r.groups.size() > 1) {
-      std::vector<Group> merged;
-      for (const auto& g : r.groups) {
-        auto it = std::find_if(merged.begin(), merged.end(), [&](const Group& x) {
-          return x.phase_b == g.phase_b && (!r.uses_passed || x.timer_time == g.timer_time);
-        });
-        if (it == merged.end()) merged.push_back(g);
-        else it->count += g.count;
+      size_t kept = 0;
+      for (size_t gi = 0; gi < r.groups.size(); ++gi) {
+        const Group& g = r.groups[gi];
+        size_t k = 0;
+        while (k < kept && !(r.groups[k].phase_b == g.phase_b && (!r.uses_passed || r.groups[k].timer_time == g.timer_time))) ++k;
+        if (k < kept) r.groups[k].count += g.count;
+        else r.groups[kept++] = g;
       }
-      r.groups.swap(merged);
+      r.groups.resize(kept);
     }
-    m.call(r.commit, r.addr);
     if (!was_violated && r.verdict.violated()) newly_.push_back(ri);
   }
   return !newly_.empty();

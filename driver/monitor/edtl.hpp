@@ -110,9 +110,9 @@ class MonitorSet {
  private:
   struct Req {
     const RequirementSpec* spec = nullptr;
-    uint32_t entry = 0, commit = 0, addr = 0;
+    uint32_t entry = 0, addr = 0;
     st::VarHandle out[6];  // trig inv fin del react rel
-    st::VarHandle elapsed;
+    st::VarHandle elapsed, state;
     bool uses_passed = false;
     std::vector<Group> groups;
     Verdict verdict;
@@ -120,6 +120,7 @@ class MonitorSet {
   bool eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6]);
   std::vector<Req> reqs_;
   std::vector<size_t> newly_;
+  uint64_t state_ = 0;
 };
 
 std::string format_verdicts(const std::vector<Verdict>& v, int64_t cycle_ns = 0);

@@ -294,23 +294,41 @@ void Compiler::compile_pou(PouInfo* p) {
     b_->template_fix.push_back(static_cast<uint32_t>(b_->code.size() - 1) | 0x40000000u);  // length
   }
   entries.push_back(0);
+  // Monitors: the first evaluation of a new state (input __state differs from the last
+  // one seen) first shifts the temporal operators' values (previous := current); later
+  // evaluations of the same state (one per timer point) see the same previous values.
+  const Symbol* state_in = p->late && p->kind == PouKind::Program ? lookup("__STATE") : nullptr;
+  Label shift = new_label(), body_start = new_label();
+  Slot seen;
+  if (state_in) {
+    seen = hidden(8, 8);
+    emit(Op::JNE_I64, {Arg::target(shift.id), Slot{state_in->offset, SK::Var}, seen});
+    bind(body_start);
+  }
   if (decl) stmts(decl->body);
   mark(decl ? decl->end_loc : SourceLoc{});
   emit(Op::RET, {});
-  if (p->late && p->kind == PouKind::Program) {
-    // Monitors: a second entry commits the state of the temporal operators (previous
-    // := current) once per state, after any number of evaluations of that state.
-    entries.push_back(static_cast<uint32_t>(b_->code.size()));
-    for (const auto& e : b_->edges) {
-      if (e.size == 1 || e.size == 2 || e.size == 4 || e.size == 8) emit(mov_op(e.size), {e.prev, e.cur});
-      else emit(Op::MOVN, {e.prev, e.cur, e.size});
+  if (state_in) {
+    bind(shift);
+    if (!b_->edges.empty()) {
+      // The first state has no previous one: the operators stay FALSE until a shift
+      // from a state that was evaluated.
+      Label skip = new_label();
+      Slot zero = konst_i64(0);
+      if (!b_->started) b_->started = hidden(1, 1);
+      emit(Op::JLT_I64, {Arg::target(skip.id), seen, zero});
+      emit(Op::MOV1, {*b_->started, konst(elem(TypeKind::Bool), ConstV{ConstV::K::Bool, 1, 0, {}}, p->decl->loc)});
+      bind(skip);
+      for (const auto& e : b_->edges) {
+        if (e.size == 1 || e.size == 2 || e.size == 4 || e.size == 8) emit(mov_op(e.size), {e.prev, e.cur});
+        else emit(Op::MOVN, {e.prev, e.cur, e.size});
+      }
     }
-    if (b_->started) emit(Op::MOV1, {*b_->started, konst(elem(TypeKind::Bool), ConstV{ConstV::K::Bool, 1, 0, {}}, p->decl->loc)});
-    emit(Op::RET, {});
+    emit(Op::MOV8, {seen, Slot{state_in->offset, SK::Var}});
+    emit(Op::JMP, {Arg::target(body_start.id)});
   }
   finish_body(*body, p, &entries);
   p->entry = entries[0];
-  if (entries.size() > 1) p->commit_entry = entries[1];
   p->compiled = true;
   compiling_.pop_back();
 
@@ -344,6 +362,11 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
 
   // The frame's initial image: header, variables' initial values, constants.
   std::vector<uint8_t> image(frame_size, 0);
+  // Monitors: the last state seen starts at -1 (no state evaluated yet).
+  if (p->late && p->kind == PouKind::Program && b.hidden_size >= 8) {
+    int64_t minus_one = -1;
+    std::memcpy(image.data() + hidden_base, &minus_one, 8);
+  }
   if (p->base && p->base->type) std::copy(p->base->type->init.begin(), p->base->type->init.end(), image.begin());
   if (p->type_id) put<uint16_t>(image.data(), static_cast<uint16_t>(p->type_id));
   for (const auto& v : p->vars)

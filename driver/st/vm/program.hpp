@@ -82,7 +82,6 @@ struct PouInfo {
   uint32_t tmpl_from = 0, tmpl_to = 0;  // frame part (re)initialized per call, from a template
   uint32_t template_addr = 0;           // absolute address of that template
   uint32_t entry = 0;       // code index of the body
-  uint32_t commit_entry = 0;  // monitors: advances the temporal operators to the next state
   uint32_t selector = 0;    // METHOD: global selector for dynamic dispatch
   uint32_t mock_addr = 0;   // FUNCTION in test builds: {flag, pad, value} block
   bool declared = false;    // signature and variable layout done
