@@ -1253,6 +1253,22 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     return native(rt2->kind == TypeKind::Real ? Native::EXPT_F32 : Native::EXPT_F64, rt2, {x, y});
   }
   if (!t->is_numeric() && !t->is_bitstring()) return op_error();
+  // Division by a constant: multiply by a precomputed reciprocal instead of dividing.
+  if ((e.op == BinaryOp::Div || e.op == BinaryOp::Mod) && r.is_const && r.c.k == ConstV::K::Int &&
+      (t->storage() == Storage::I16 || t->storage() == Storage::I32) && r.c.i != 0 && r.c.i != 1 && r.c.i != -1 &&
+      r.c.i >= INT32_MIN + 1 && r.c.i <= INT32_MAX) {
+    uint64_t k = static_cast<uint64_t>(r.c.i < 0 ? -r.c.i : r.c.i);
+    uint64_t m = (uint64_t(1) << 63) / k + 1;
+    bool i16 = t->storage() == Storage::I16;
+    Op divop = e.op == BinaryOp::Div ? (i16 ? Op::DIVK_I16 : Op::DIVK_I32) : (i16 ? Op::MODK_I16 : Op::MODK_I32);
+    Slot d = temp_for(t);
+    emit(divop, {d, a, static_cast<uint32_t>(m), static_cast<uint32_t>(m >> 32), static_cast<uint32_t>(static_cast<int32_t>(r.c.i))});
+    def(d);
+    Val v;
+    v.type = t;
+    v.slot = d;
+    return v;
+  }
   switch (e.op) {
     case BinaryOp::Add: return emit_bin(Op::ADD_I8, t, a, b, t);
     case BinaryOp::Sub: return emit_bin(Op::SUB_I8, t, a, b, t);

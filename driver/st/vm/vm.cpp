@@ -17,6 +17,8 @@ constexpr OpInfo kOps[] = {
 #undef OP
 };
 
+__extension__ typedef unsigned __int128 U128;  // one MUL on x86-64 and AArch64
+
 template <class T>
 inline T ld(const uint8_t* p) {
   T v;
@@ -566,6 +568,23 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   LDXS_IMPL(4, uint32_t)
   LDXS_IMPL(8, uint64_t)
 #undef LDXS_IMPL
+
+#define DIVK_IMPL(NAME, T, IS_MOD)                                                      \
+  L_##NAME: {                                                                           \
+    int64_t n = R(T, 2);                                                                \
+    uint64_t m = static_cast<uint64_t>(pc[3]) | (static_cast<uint64_t>(pc[4]) << 32);   \
+    int64_t k = static_cast<int32_t>(pc[5]);                                            \
+    uint64_t un = static_cast<uint64_t>(n < 0 ? -n : n);                                \
+    auto q = static_cast<int64_t>(static_cast<uint64_t>((static_cast<U128>(un) * m) >> 63)); \
+    if ((n < 0) != (k < 0)) q = -q;                                                     \
+    W(T, 1, static_cast<T>(IS_MOD ? n - q * k : q));                                    \
+    NEXT(5);                                                                            \
+  }
+  DIVK_IMPL(DIVK_I16, int16_t, false)
+  DIVK_IMPL(DIVK_I32, int32_t, false)
+  DIVK_IMPL(MODK_I16, int16_t, true)
+  DIVK_IMPL(MODK_I32, int32_t, true)
+#undef DIVK_IMPL
 
 #undef DISPATCH
 #undef NEXT
