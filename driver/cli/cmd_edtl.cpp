@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "json.hpp"
 #include "engine.hpp"
 #include "monitor/edtl.hpp"
 #include "report/junit.hpp"
@@ -13,21 +14,6 @@
 namespace po = boost::program_options;
 
 namespace plcfi::cli {
-
-namespace {
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (c == '\n') out += "\\n";
-    else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    else out += c;
-  }
-  return out;
-}
-
-}  // namespace
 
 std::string verdicts_json(const std::vector<monitor::Verdict>& vs) {
   std::string out = "[";

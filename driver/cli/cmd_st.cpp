@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "json.hpp"
 #include "engine.hpp"
 #include "report/junit.hpp"
 #include "runtime/schedule.hpp"
@@ -56,16 +57,6 @@ std::unique_ptr<st::Build> load(const std::vector<std::string>& files, const st:
   return b;
 }
 
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (c == '\n') out += "\\n";
-    else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    else out += c;
-  }
-  return out;
-}
 
 std::string json_value(const st::Machine& m, const st::VarHandle& h) {
   const st::Type* t = h.type;

@@ -1,6 +1,7 @@
 // Engine facade: building from files, variable handles, value formatting, disassembly,
 // coverage reports and trap descriptions.
 #include "engine.hpp"
+#include "vm/memory.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,13 +19,11 @@ namespace plcfi::st {
 namespace {
 template <class T>
 T ld(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  return v;
+  return load_as<T>(p);
 }
 template <class T>
 void st(uint8_t* p, T v) {
-  std::memcpy(p, &v, sizeof(T));
+  store_as<T>(p, v);
 }
 
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32_t>& files, const CompileOptions& opt,

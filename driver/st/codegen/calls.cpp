@@ -81,6 +81,10 @@ std::vector<const Expr*> Compiler::positional(const CallExpr& c, size_t min, siz
 }
 
 Val Compiler::native(Native n, const Type* result, std::initializer_list<Slot> args, uint32_t cap) {
+  return native_list(n, result, std::vector<Slot>(args), cap);
+}
+
+Val Compiler::native_list(Native n, const Type* result, const std::vector<Slot>& args, uint32_t cap) {
   Slot d = result->is_string() ? temp(result->size, 1) : temp_for(result);
   Arg a[4] = {0u, 0u, 0u, 0u};
   size_t i = 0;
@@ -1021,29 +1025,31 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
     return v.is_const ? konst(elem(TypeKind::LInt), v.c, e->loc) : convert(v.slot, t, elem(TypeKind::LInt));
   };
   const Type* rstr = tt_->string_type(255, false);
-  if (name == "LEN") {
-    auto args = positional(c, 1, 1, "LEN");
+  // String functions with fixed operand lists: S = string, I = integer (passed as LINT).
+  struct StringFn {
+    const char* name;
+    const char* args;
+    Native fn;
+    bool int_result;
+  };
+  static const StringFn kStringFns[] = {
+      {"LEN", "S", Native::S_LEN, true},           {"LEFT", "SI", Native::S_LEFT, false},
+      {"RIGHT", "SI", Native::S_RIGHT, false},     {"MID", "SII", Native::S_MID, false},
+      {"INSERT", "SSI", Native::S_INSERT, false},  {"DELETE", "SII", Native::S_DELETE, false},
+      {"FIND", "SS", Native::S_FIND, true},
+  };
+  for (const auto& f : kStringFns) {
+    if (name != f.name) continue;
+    size_t n = std::strlen(f.args);
+    auto args = positional(c, n, n, f.name);
     if (args.empty()) return bad();
-    auto s = str_arg(args[0]);
-    if (!s) return bad();
-    return native(Native::S_LEN, elem(TypeKind::Int), {*s});
-  }
-  if (name == "LEFT" || name == "RIGHT") {
-    auto args = positional(c, 2, 2, name.c_str());
-    if (args.empty()) return bad();
-    auto s = str_arg(args[0]);
-    auto l = int_arg(args[1]);
-    if (!s || !l) return bad();
-    return native(name == "LEFT" ? Native::S_LEFT : Native::S_RIGHT, rstr, {*s, *l}, 255);
-  }
-  if (name == "MID") {
-    auto args = positional(c, 3, 3, "MID");
-    if (args.empty()) return bad();
-    auto s = str_arg(args[0]);
-    auto l = int_arg(args[1]);
-    auto p = int_arg(args[2]);
-    if (!s || !l || !p) return bad();
-    return native(Native::S_MID, rstr, {*s, *l, *p}, 255);
+    std::vector<Slot> slots;
+    for (size_t i = 0; i < n; ++i) {
+      auto s = f.args[i] == 'S' ? str_arg(args[i]) : int_arg(args[i]);
+      if (!s) return bad();
+      slots.push_back(*s);
+    }
+    return native_list(f.fn, f.int_result ? elem(TypeKind::Int) : rstr, slots, f.int_result ? 0 : 255);
   }
   if (name == "CONCAT") {
     auto args = positional(c, 2, SIZE_MAX, "CONCAT");
@@ -1091,14 +1097,6 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
     emit(Op::MOV8, {lp, *l});
     emit(Op::MOV8, {lp.plus(8), *p});
     return native(Native::S_REPLACE, rstr, {*a, *b, lp}, 255);
-  }
-  if (name == "FIND") {
-    auto args = positional(c, 2, 2, "FIND");
-    if (args.empty()) return bad();
-    auto a = str_arg(args[0]);
-    auto b = str_arg(args[1]);
-    if (!a || !b) return bad();
-    return native(Native::S_FIND, elem(TypeKind::Int), {*a, *b});
   }
   if (name == "ADR" || name == "REF") {
     auto args = positional(c, 1, 1, name.c_str());

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "compiler_impl.hpp"
+#include "vm/memory.hpp"
 #include "syntax/parser.hpp"
 
 namespace plcfi::st {
@@ -110,10 +111,9 @@ ValueKind value_kind(const Type* t) {
 }
 
 namespace {
-uint32_t align_up(uint32_t v, uint32_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
 template <class T>
 void put(uint8_t* p, T v) {
-  std::memcpy(p, &v, sizeof(T));
+  store_as<T>(p, v);
 }
 }  // namespace
 

@@ -245,6 +245,7 @@ class Compiler {
   void property_set(PouInfo* setter, Slot this_ptr, const Val& v, SourceLoc loc);
   std::vector<const Expr*> positional(const CallExpr& c, size_t min, size_t max, const char* name);
   Val native(Native n, const Type* result, std::initializer_list<Slot> args, uint32_t cap = 0);
+  Val native_list(Native n, const Type* result, const std::vector<Slot>& args, uint32_t cap = 0);
 
   // ---- state
   const SourceManager& sm_;
@@ -283,6 +284,8 @@ class Compiler {
 };
 
 std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r, std::string* err);
+
+inline uint32_t align_up(uint32_t v, uint32_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
 
 // Opcode families are laid out per storage type (see opcodes.def); these pick the member.
 uint32_t storage_index(Storage s);  // I8..F64 -> 0..9

@@ -6,15 +6,15 @@
 #include <functional>
 
 #include "compiler_impl.hpp"
+#include "vm/memory.hpp"
 
 namespace plcfi::st::detail {
 
 namespace {
-uint32_t align_up(uint32_t v, uint32_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
 
 template <class T>
 void put(uint8_t* p, T v) {
-  std::memcpy(p, &v, sizeof(T));
+  store_as<T>(p, v);
 }
 }  // namespace
 
@@ -433,65 +433,11 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
       auto l = const_eval(*b.lhs, file, report);
       auto r = const_eval(*b.rhs, file, report);
       if (!l || !r) return std::nullopt;
-      bool real = l->k == ConstV::K::Real || r->k == ConstV::K::Real;
-      if (real || b.op == BinaryOp::Pow) {
-        if (l->k == ConstV::K::Str || r->k == ConstV::K::Str) return fail("string constants cannot be combined");
-        double x = l->k == ConstV::K::Real ? l->r : static_cast<double>(l->i);
-        double y = r->k == ConstV::K::Real ? r->r : static_cast<double>(r->i);
-        ConstV c;
-        c.k = ConstV::K::Real;
-        switch (b.op) {
-          case BinaryOp::Add: c.r = x + y; return c;
-          case BinaryOp::Sub: c.r = x - y; return c;
-          case BinaryOp::Mul: c.r = x * y; return c;
-          case BinaryOp::Div: c.r = x / y; return c;
-          case BinaryOp::Pow: c.r = std::pow(x, y); return c;
-          default: break;
-        }
-        c.k = ConstV::K::Bool;
-        switch (b.op) {
-          case BinaryOp::Lt: c.i = x < y; return c;
-          case BinaryOp::Gt: c.i = x > y; return c;
-          case BinaryOp::Le: c.i = x <= y; return c;
-          case BinaryOp::Ge: c.i = x >= y; return c;
-          case BinaryOp::Eq: c.i = x == y; return c;
-          case BinaryOp::Ne: c.i = x != y; return c;
-          default: return fail("operator not applicable to REAL constants");
-        }
-      }
-      if (l->k == ConstV::K::Str || r->k == ConstV::K::Str) return fail("string constants cannot be combined");
-      int64_t x = l->i, y = r->i;
-      auto ux = static_cast<uint64_t>(x), uy = static_cast<uint64_t>(y);
-      ConstV c;
-      c.k = (l->k == ConstV::K::Bool && r->k == ConstV::K::Bool) ? ConstV::K::Bool : ConstV::K::Int;
-      switch (b.op) {
-        case BinaryOp::Add: c.i = static_cast<int64_t>(ux + uy); return c;
-        case BinaryOp::Sub: c.i = static_cast<int64_t>(ux - uy); return c;
-        case BinaryOp::Mul: c.i = static_cast<int64_t>(ux * uy); return c;
-        case BinaryOp::Div:
-        case BinaryOp::Mod:
-          if (y == 0) {
-            if (report) diags_.error("ST217", b.rhs->loc, "division by zero in a constant expression");
-            return std::nullopt;
-          }
-          if (y == -1) c.i = b.op == BinaryOp::Div ? static_cast<int64_t>(0ULL - ux) : 0;
-          else c.i = b.op == BinaryOp::Div ? x / y : x % y;
-          return c;
-        case BinaryOp::And: c.i = x & y; return c;
-        case BinaryOp::Or: c.i = x | y; return c;
-        case BinaryOp::Xor: c.i = x ^ y; return c;
-        default: break;
-      }
-      c.k = ConstV::K::Bool;
-      switch (b.op) {
-        case BinaryOp::Lt: c.i = x < y; return c;
-        case BinaryOp::Gt: c.i = x > y; return c;
-        case BinaryOp::Le: c.i = x <= y; return c;
-        case BinaryOp::Ge: c.i = x >= y; return c;
-        case BinaryOp::Eq: c.i = x == y; return c;
-        case BinaryOp::Ne: c.i = x != y; return c;
-        default: return fail("operator not applicable in a constant expression");
-      }
+      std::string why;
+      auto c = fold_binary(b.op, *l, *r, &why);
+      if (!c && report) diags_.error(why.find("zero") != std::string::npos ? "ST217" : "ST215",
+                                     why.find("zero") != std::string::npos ? b.rhs->loc : e.loc, why);
+      return c;
     }
     default: return fail("a constant expression is required here");
   }

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "memory.hpp"
 #include "vm.hpp"
 
 namespace plcfi::st {
@@ -16,13 +17,11 @@ namespace plcfi::st {
 namespace {
 template <class T>
 T ld(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  return v;
+  return load_as<T>(p);
 }
 template <class T>
 void st(uint8_t* p, T v) {
-  std::memcpy(p, &v, sizeof(T));
+  store_as<T>(p, v);
 }
 char* cs(uint8_t* p) { return reinterpret_cast<char*>(p); }
 

@@ -1,4 +1,5 @@
 // The VM's dispatch loop (computed goto over opcodes.def) and its trap handling.
+#include "memory.hpp"
 #include "vm.hpp"
 
 #include <cmath>
@@ -21,13 +22,11 @@ __extension__ typedef unsigned __int128 U128;  // one MUL on x86-64 and AArch64
 
 template <class T>
 inline T ld(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  return v;
+  return load_as<T>(p);
 }
 template <class T>
 inline void st(uint8_t* p, T v) {
-  std::memcpy(p, &v, sizeof(T));
+  store_as<T>(p, v);
 }
 
 // Two's-complement wraparound without undefined behaviour (IEC integer overflow wraps).
