@@ -25,7 +25,8 @@ void check_divisor(int32_t k, const char* type) {
   auto n = *resolve(*b->app, "P.n", &err), q = *resolve(*b->app, "P.q", &err), r = *resolve(*b->app, "P.r", &err);
   const auto& inst = b->app->programs[0];
   std::mt19937 rng(static_cast<unsigned>(k) * 7919u);
-  std::vector<int64_t> values{0, 1, -1, k, -k, k - 1, k + 1, -k + 1, -k - 1, std::numeric_limits<T>::min(),
+  const int64_t kk = k;  // neighbours of k computed without overflow
+  std::vector<int64_t> values{0, 1, -1, kk, -kk, kk - 1, kk + 1, -kk + 1, -kk - 1, std::numeric_limits<T>::min(),
                               std::numeric_limits<T>::max(), std::numeric_limits<T>::min() + 1};
   for (int i = 0; i < 2000; ++i) values.push_back(static_cast<T>(rng()));
   for (int64_t v : values) {
