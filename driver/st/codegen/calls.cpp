@@ -352,6 +352,9 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     Val v = expr_for(*a.value, p->type);
     assign(field, v, a.value->loc);
   }
+  for (Symbol* p : params)
+    if (p->where == Where::InOut && std::find(passed.begin(), passed.end(), p) == passed.end())
+      diags_.error("ST224", c.loc, "VAR_IN_OUT '" + p->name + "' of " + fb->name + " must be passed in every call");
   mark(c.loc);
   PouInfo* target = body_of ? body_of : fb;
   switch (inst.k) {

@@ -508,8 +508,8 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
       auto it = pous_.find(canon(d->extends->text));
       if (it == pous_.end() || (p->kind == PouKind::FunctionBlock && it->second->kind != PouKind::FunctionBlock) ||
           (p->kind == PouKind::Interface && it->second->kind != PouKind::Interface)) {
-        diags_.error("ST226", d->extends->loc, "'" + d->extends->text + "' is not a " +
-                                                   (p->kind == PouKind::Interface ? "n interface" : " function block"));
+        diags_.error("ST226", d->extends->loc, "'" + d->extends->text + "' is not " +
+                                                   (p->kind == PouKind::Interface ? "an interface" : "a function block"));
       } else if (p->kind == PouKind::Interface) {
         p->interfaces.push_back(it->second);
       } else {
@@ -561,6 +561,10 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
       for (const auto& r : c.resources) declare_globals(r.globals, r.name.text, u->file);
     }
   }
+
+  // Every declared type is resolved (and so checked), used or not.
+  for (auto& [key, te] : types_)
+    if (!te.type) named_type(Ident{te.decl->name.text, te.decl->name.loc}, te.file);
 
   // Every POU is compiled (and so checked), used or not.
   for (size_t i = 0; i < app_->pous.size(); ++i)
