@@ -10,13 +10,20 @@
 #include <random>
 #include <set>
 
+#include <unistd.h>
+
 #include "monitor/edtl.hpp"
 
 namespace plcfi::monitor {
 namespace {
 
+// Temporary files are unique per test and process: ctest runs tests in parallel.
 std::string write_temp(const std::string& name, const std::string& text) {
-  auto p = (std::filesystem::temp_directory_path() / name).string();
+  static int counter = 0;
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string unique = std::string(info ? info->test_suite_name() : "x") + "_" + (info ? info->name() : "y") + "_" +
+                       std::to_string(::getpid()) + "_" + std::to_string(++counter) + "_" + name;
+  auto p = (std::filesystem::temp_directory_path() / unique).string();
   std::ofstream f(p);
   f << text;
   return p;
@@ -31,6 +38,9 @@ std::vector<Verdict> check(const std::string& reqs_yaml, const std::string& csv,
   EXPECT_TRUE(load_requirements(rp, &reqs, &err)) << err;
   TraceCheck out;
   EXPECT_TRUE(check_trace(reqs, tp, cycle_ns, &out, &err)) << err;
+  std::filesystem::remove(rp);
+  std::filesystem::remove(tp);
+  if (out.verdicts.empty()) out.verdicts.resize(1);  // a failed check is reported above; keep v[0] valid
   return out.verdicts;
 }
 

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include "engine.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "monitor/edtl.hpp"
@@ -167,7 +169,7 @@ TEST(StampingPlant, VcdTraceReadsBack) {
     ASSERT_TRUE(h) << err;
     vars.push_back(*h);
   }
-  auto path = (std::filesystem::temp_directory_path() / "plcfi_test_trace.vcd").string();
+  auto path = (std::filesystem::temp_directory_path() / ("plcfi_test_trace_" + std::to_string(::getpid()) + ".vcd")).string();
   auto vcd = report::open_vcd(path, vars, &err);
   ASSERT_TRUE(vcd) << err;
   int rises = 0;
@@ -224,8 +226,8 @@ class MonitorAndTrace final : public rt::ScanHooks {
 
 TEST(StampingPlant, RequirementsGiveTheSameVerdictOnlineAndOffline) {
   auto dir = std::filesystem::temp_directory_path();
-  auto reqs_path = (dir / "plcfi_test_reqs.yaml").string();
-  auto csv_path = (dir / "plcfi_test_trace.csv").string();
+  auto reqs_path = (dir / ("plcfi_test_reqs_" + std::to_string(::getpid()) + ".yaml")).string();
+  auto csv_path = (dir / ("plcfi_test_trace_" + std::to_string(::getpid()) + ".csv")).string();
   {
     std::ofstream f(reqs_path);
     f << "requirements:\n"
