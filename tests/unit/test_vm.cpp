@@ -435,8 +435,6 @@ TEST(VmArithmetic, TruncOfLrealRoundsTowardZero) {
 }
 
 TEST(VmArithmetic, TruncOfRealRoundsTowardZero) {
-  GTEST_SKIP() << "engine bug: TRUNC of a REAL emits TRUNC_F64 (reads the 4-byte REAL as a double); "
-                  "x : REAL := 2.5; c := TRUNC(x) gives 0";
   VmRun r("PROGRAM Main\nVAR x : REAL := 2.5; y : REAL := -2.5; c, d : DINT; END_VAR\nc := TRUNC(x); d := TRUNC(y);\nEND_PROGRAM\n");
   ASSERT_TRUE(r.ok());
   ASSERT_TRUE(r.scan());

@@ -571,7 +571,7 @@ std::optional<Val> Compiler::conversion(const std::string& name, const CallExpr&
       return bad();
     }
     Slot t = temp_for(from);
-    emit(num_op(Op::ROUND_F32, from->storage()) == Op::ROUND_F32 ? Op::TRUNC_F32 : Op::TRUNC_F64, {t, s});
+    emit(from->kind == TypeKind::Real ? Op::TRUNC_F32 : Op::TRUNC_F64, {t, s});
     out.slot = cvt(t, from, to);
     return out;
   }
