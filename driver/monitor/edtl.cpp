@@ -250,8 +250,17 @@ void remap_diagnostics(st::Build& build, const MonitorSource& src, const Require
 // ------------------------------------------------------------------ checking
 
 std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const RequirementsFile& reqs, std::string* err) {
+  return create(app, reqs, 0, reqs.requirements.size(), err);
+}
+
+std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const RequirementsFile& reqs, size_t first,
+                                               size_t count, std::string* err) {
   auto set = std::make_unique<MonitorSet>();
-  for (size_t i = 0; i < reqs.requirements.size(); ++i) {
+  if (first + count > reqs.requirements.size()) {
+    *err = "monitor range beyond the requirements";
+    return nullptr;
+  }
+  for (size_t i = first; i < first + count; ++i) {
     const auto& spec = reqs.requirements[i];
     std::string name = program_name(i);
     const st::ProgramInstance* inst = nullptr;

@@ -87,6 +87,10 @@ class MonitorSet {
   // Binds to the compiled monitors; the build must contain generate_monitors() output as
   // late units. Fails when a monitor program is missing.
   static std::unique_ptr<MonitorSet> create(const st::Application& app, const RequirementsFile& reqs, std::string* err);
+  // Binds only requirements [first, first + count) of `reqs` (a campaign monitors one
+  // test case's requirements at a time, out of one build holding all of them).
+  static std::unique_ptr<MonitorSet> create(const st::Application& app, const RequirementsFile& reqs, size_t first,
+                                            size_t count, std::string* err);
 
   // Evaluates state `state` at time t (ns) on the machine's current memory: call once
   // per state, in order. Returns true when some requirement got its first violation

@@ -60,6 +60,31 @@ void Runtime::stop(const std::string& reason) {
   write_safe_outputs();
 }
 
+bool Runtime::run_due_tasks(std::string* stop_reason) {
+  bool ok = true;
+  schedule_.for_each_due(scans_, [&](const ScheduledTask& t) {
+    for (size_t pi : t.programs) {
+      if (!ok) return;
+      const auto& inst = app_->programs[pi];
+      if (!machine_.call(inst.pou->entry, inst.addr)) {
+        ok = false;
+        if (stop_reason) *stop_reason = st::describe_trap(*app_, machine_.trap()) + " (program " + inst.name + ")";
+      }
+    }
+  });
+  return ok;
+}
+
+const std::vector<uint64_t>& Runtime::probe_branches() {
+  probe_mem_.assign(machine_.mem(), machine_.mem() + machine_.mem_size());
+  machine_.clear_taken();
+  if (!stopped_) run_due_tasks(nullptr);
+  probe_taken_ = machine_.taken();
+  std::memcpy(machine_.mem(), probe_mem_.data(), probe_mem_.size());
+  machine_.clear_taken();
+  return probe_taken_;
+}
+
 ScanStatus Runtime::scan() {
   const int64_t tick = schedule_.tick_ns();
   ScanStatus status = ScanStatus::Ok;
@@ -70,17 +95,10 @@ ScanStatus Runtime::scan() {
   machine_.clear_taken();
   for (ScanHooks* h : hooks_) h->before_scan(*this);
   if (!stopped_) {
-    schedule_.for_each_due(scans_, [&](const ScheduledTask& t) {
-      for (size_t pi : t.programs) {
-        if (stopped_) return;
-        const auto& inst = app_->programs[pi];
-        if (!machine_.call(inst.pou->entry, inst.addr)) {
-          stopped_ = true;
-          stop_reason_ = st::describe_trap(*app_, machine_.trap()) + " (program " + inst.name + ")";
-          status = ScanStatus::Trapped;
-        }
-      }
-    });
+    if (!run_due_tasks(&stop_reason_)) {
+      stopped_ = true;
+      status = ScanStatus::Trapped;
+    }
   } else if (status == ScanStatus::Ok) {
     status = ScanStatus::Stopped;
   }

@@ -69,6 +69,13 @@ class Runtime {
   const std::string& stop_reason() const { return stop_reason_; }
   const st::Trap& trap() const { return machine_.trap(); }
 
+  // Runs the tasks due in this scan on a copy of the program state and returns the branch
+  // ids they took (Machine::taken() layout), then puts memory back as it was: the
+  // control-flow path the scan is about to take. For before-scan hooks (the campaign
+  // driver tells paths to a precondition apart with it); allocates nothing after the
+  // first call. A trap in the probe is forgotten: the real scan will meet it again.
+  const std::vector<uint64_t>& probe_branches();
+
   // All outputs to the safe state (zero: valves off, setpoints 0) and sent to the backend.
   void write_safe_outputs();
   // Stops the program (e.g. a watchdog of the caller); outputs go to the safe state.
@@ -76,6 +83,8 @@ class Runtime {
 
  private:
   void restart(uint64_t seed, bool warm);
+  // Runs the tasks due at the current tick; false when one trapped (the trap is in machine_).
+  bool run_due_tasks(std::string* stop_reason);
   uint32_t in_extent() const;
   uint32_t out_extent() const;
 
@@ -86,6 +95,8 @@ class Runtime {
   std::vector<ScanHooks*> hooks_;
   Overlay in_overlay_, out_overlay_;
   std::vector<uint8_t> raw_in_, out_;
+  std::vector<uint8_t> probe_mem_;
+  std::vector<uint64_t> probe_taken_;
   int64_t now_ns_ = 0;
   uint64_t scans_ = 0;
   bool stopped_ = false;

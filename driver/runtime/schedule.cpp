@@ -1,6 +1,8 @@
 // Task schedule construction and duration parsing for command-line options.
 #include "schedule.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
 #include <numeric>
@@ -34,7 +36,8 @@ bool Schedule::single_program(const st::Application& app, const std::string& pro
     if (program.empty() || st::iequals(app.programs[i].name, program) || st::iequals(app.programs[i].pou->name, program))
       match.push_back(i);
   std::string names;
-  for (const auto& p : app.programs) names += (names.empty() ? "" : ", ") + p.name;
+  for (size_t i = 0; i < app.programs.size() && i < 20; ++i) names += (names.empty() ? "" : ", ") + app.programs[i].name;
+  if (app.programs.size() > 20) names += fmt::format(" and {} more", app.programs.size() - 20);
   if (match.empty()) {
     *err = program.empty() ? "no PROGRAM to run" : "no program '" + program + "'" + (names.empty() ? "" : " (programs: " + names + ")");
     return false;

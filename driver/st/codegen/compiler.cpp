@@ -652,7 +652,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   }
   if (!app_->has_configuration && !opt_.test_mode) {
     for (const auto& p : app_->pous)
-      if (p->kind == PouKind::Program && !p->is_stdlib) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
+      if (p->kind == PouKind::Program && !p->is_stdlib && !p->late) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
   }
   for (auto& pi : app_->programs) {
     if (!pi.pou->compiled) continue;

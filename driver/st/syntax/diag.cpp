@@ -59,6 +59,23 @@ std::string DiagEngine::render(const Diagnostic& d) const {
   return out;
 }
 
+void DiagEngine::remove_duplicates() {
+  std::vector<Diagnostic> kept;
+  for (auto& d : diags_) {
+    bool dup = false;
+    for (const auto& k : kept)
+      dup = dup || (k.loc.file == d.loc.file && k.loc.line == d.loc.line && k.loc.col == d.loc.col && k.code == d.code &&
+                    k.message == d.message);
+    if (!dup) {
+      kept.push_back(std::move(d));
+      continue;
+    }
+    if (d.severity == Severity::Error) --errors_;
+    else --warnings_;
+  }
+  diags_ = std::move(kept);
+}
+
 std::string DiagEngine::render_all() const {
   // Source order, whichever stage found a problem first (declarations are checked
   // after bodies start compiling, so collection order is not reading order).

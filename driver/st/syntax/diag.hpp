@@ -34,6 +34,10 @@ class DiagEngine {
   // Caps runaway output on garbage input; further errors are counted but not stored.
   static constexpr size_t kMaxStored = 500;
 
+  // Drops repeated diagnostics (same location, code and message), e.g. from generated
+  // code that instantiates one user formula several times.
+  void remove_duplicates();
+
   // Renders one diagnostic with its source line and caret.
   std::string render(const Diagnostic& d) const;
   std::string render_all() const;
