@@ -12,5 +12,7 @@ int cmd_test(const std::vector<std::string>& args);
 int cmd_disasm(const std::vector<std::string>& args);
 int cmd_sim(const std::vector<std::string>& args);
 int cmd_edtl(const std::vector<std::string>& args);
+int cmd_generate(const std::vector<std::string>& args);
+int cmd_campaign(const std::vector<std::string>& args);
 
 }  // namespace plcfi::cli

@@ -29,6 +29,8 @@ const std::vector<Command>& commands() {
       {"disasm", "print the bytecode of ST files with their source lines", plcfi::cli::cmd_disasm},
       {"sim", "run a PLC program on a plant model in virtual time", plcfi::cli::cmd_sim},
       {"edtl", "check EDTL requirements on a recorded trace (edtl check REQS TRACE)", plcfi::cli::cmd_edtl},
+      {"generate", "generate the prioritized fault-injection test cases of a campaign (TSD + FMEA)", plcfi::cli::cmd_generate},
+      {"campaign", "run a passive fault-injection campaign on the plant model", plcfi::cli::cmd_campaign},
   };
   return k;
 }

@@ -1,0 +1,435 @@
+// The passive driver: scan hooks, runs and restarts, verdicts, the results journal.
+#include "driver.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "io/sim/sim_backend.hpp"
+#include "journal.hpp"
+#include "plant_model/plant.hpp"
+#include "report/trace.hpp"
+#include "runtime/runtime.hpp"
+
+namespace plcfi::campaign {
+
+const char* outcome_name(Outcome o) {
+  switch (o) {
+    case Outcome::Pass: return "PASS";
+    case Outcome::Fail: return "FAIL";
+    case Outcome::NotReached: return "NOT REACHED";
+  }
+  return "?";
+}
+
+std::string campaign_fingerprint(const CampaignBuild& cb) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const std::string& s) {
+    for (unsigned char ch : s) h = (h ^ ch) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;
+  };
+  mix(cb.spec.name);
+  mix(std::to_string(cb.spec.seed));
+  mix(std::to_string(cb.spec.max_paths));
+  for (const auto& p : cb.spec.programs) {
+    std::ifstream in(p);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    mix(text);  // another program under test is another campaign
+  }
+  for (const auto& c : cb.cases) {
+    mix(c.id);
+    mix(c.precondition);
+    mix(c.fault.text);
+    mix(c.target->bind);
+    mix(std::to_string(c.deadline_ns));
+  }
+  return fmt::format("{:016x}", h);
+}
+
+std::vector<std::string> distinguishing_branches(const CampaignBuild& cb, const std::vector<Execution>& all,
+                                                 const Execution& e) {
+  std::vector<const Execution*> same;
+  for (const auto& x : all)
+    if (x.case_index == e.case_index) same.push_back(&x);
+  if (same.size() < 2) return {};
+  // Branch ids every path of the case took are common ground; the rest tells them apart.
+  std::set<uint32_t> common(e.branches.begin(), e.branches.end());
+  for (const auto* x : same) {
+    std::set<uint32_t> keep;
+    for (uint32_t b : x->branches)
+      if (common.count(b)) keep.insert(b);
+    common = std::move(keep);
+  }
+  std::vector<std::string> out;
+  const st::Application& app = *cb.build->app;
+  for (uint32_t b : e.branches) {
+    if (common.count(b) || b >= app.branches.size()) continue;
+    const auto& bp = app.branches[b];
+    std::string file = bp.loc.file < app.file_paths.size() ? app.file_paths[bp.loc.file] : "?";
+    out.push_back(fmt::format("{}:{} {}", std::filesystem::path(file).filename().string(), bp.loc.line, bp.kind));
+  }
+  return out;
+}
+
+namespace {
+
+// The scan hooks of one campaign: preconditions before the scan, monitors after it.
+class PassiveDriver final : public rt::ScanHooks {
+ public:
+  PassiveDriver(CampaignBuild& cb, const DriverOptions& opt) : cb_(cb), opt_(opt) {
+    const st::Application& app = *cb.build->app;
+    size_t n = cb.cases.size();
+    prev_.assign(n, 0);
+    paths_.assign(n, 0);
+    user_branch_.assign(app.branches.size(), false);
+    std::set<uint32_t> files(cb.program_files.begin(), cb.program_files.end());
+    for (size_t b = 0; b < app.branches.size(); ++b) user_branch_[b] = files.count(app.branches[b].loc.file) > 0;
+  }
+
+  // Marks (case, path) tested (a resumed journal).
+  void mark_tested(const Execution& e) {
+    tested_.insert({e.case_index, e.path_hash});
+    paths_[e.case_index] = std::max(paths_[e.case_index], e.path);
+  }
+
+  bool all_done() const {
+    for (int p : paths_)
+      if (p < cb_.spec.max_paths) return false;
+    return true;
+  }
+  size_t cases_tested() const {
+    size_t k = 0;
+    for (int p : paths_) k += p > 0;
+    return k;
+  }
+
+  void begin_run(uint64_t run) {
+    run_ = run;
+    std::fill(prev_.begin(), prev_.end(), 0);
+    active_ = SIZE_MAX;
+    done_ = false;
+    injected_ = false;
+  }
+  bool done() const { return done_; }
+  const std::string& error() const { return error_; }
+  bool injected() const { return injected_; }
+  bool active() const { return active_ != SIZE_MAX; }
+  Execution& result() { return exec_; }
+
+  void before_scan(rt::Runtime& r) override {
+    if (active_ != SIZE_MAX || done_ || r.stopped()) return;
+    st::Machine& m = r.machine();
+    if (!m.call(cb_.preconditions_entry, cb_.preconditions_addr)) return;  // a trap: no case can start
+    const uint8_t* pre = m.mem() + cb_.preconditions.addr;
+    const size_t n = prev_.size();
+    bool probed = false;
+    for (size_t i = 0; i < n; ++i) {
+      uint8_t now = pre[i];
+      bool rose = now && !prev_[i];
+      prev_[i] = now;
+      if (!rose || active_ != SIZE_MAX || paths_[i] >= cb_.spec.max_paths) continue;
+      if (!probed) {
+        path_of_scan(r);
+        probed = true;
+      }
+      if (tested_.count({i, hash_})) continue;
+      inject(r, i);
+    }
+  }
+
+  void after_scan(rt::Runtime& r) override {
+    if (active_ == SIZE_MAX) return;
+    const TestCase& tc = cb_.cases[active_];
+    int64_t t = r.now();
+    monitors_->step(r.machine(), state_++, t);
+    if (trace_) trace_->sample(t, r.machine());
+    auto v = monitors_->verdicts();
+    size_t n_class = tc.reqs - tc.forbidden;
+    bool all_met = true;
+    for (size_t k = 0; k < v.size(); ++k) {
+      if (v[k].triggers && start_time_[k] < 0) start_time_[k] = t;
+      if (k < n_class) {
+        if (v[k].holds && react_time_[k] < 0) react_time_[k] = t;
+        all_met = all_met && v[k].holds > 0;
+      }
+    }
+    for (size_t k = 0; k < v.size(); ++k) {
+      if (!v[k].violated()) continue;
+      const auto& x = v[k].violations.front();
+      const auto& spec = cb_.monitors.requirements[tc.first_req + k];
+      const std::string& req = spec.text;
+      if (k >= n_class) {
+        finish(r, Outcome::Fail, fmt::format("forbidden reaction at +{}: {}", rel(x.time_ns), req));
+      } else if (x.cause == monitor::Cause::Delay) {
+        finish(r, Outcome::Fail,
+               fmt::format("deadline missed: {} not seen within {} of the start (start at +{}, checked at +{})", spec.reaction.text,
+                           human_duration(tc.deadline_ns), rel(x.trigger_time_ns), rel(x.time_ns)));
+      } else {
+        finish(r, Outcome::Fail,
+               fmt::format("invariant broken at +{}: {} (start at +{})", rel(x.time_ns), req, rel(x.trigger_time_ns)));
+      }
+      return;
+    }
+    if (all_met) {
+      int64_t start = INT64_MAX, react = 0;
+      for (size_t k = 0; k < n_class; ++k) {
+        start = std::min(start, start_time_[k]);
+        react = std::max(react, react_time_[k]);
+      }
+      exec_.start_ns = start;
+      exec_.reaction_ns = react;
+      exec_.latency_ns = react - start;
+      finish(r, Outcome::Pass,
+             fmt::format("reaction {} ms after the start (deadline {})", static_cast<double>(react - start) * 1e-6,
+                         human_duration(tc.deadline_ns)));
+      return;
+    }
+    if (r.stopped()) {
+      finish(r, Outcome::Fail, "program stopped: " + r.stop_reason());
+      return;
+    }
+    if (t - exec_.inject_ns >= tc.max_duration_ns) {
+      std::string open;
+      for (size_t k = 0; k < n_class; ++k)
+        if (!v[k].holds)
+          open += fmt::format("{}{} ({})", open.empty() ? "" : ", ", cb_.monitors.requirements[tc.first_req + k].text,
+                              v[k].triggers ? "pending" : "start condition never held");
+      finish(r, Outcome::Fail, fmt::format("maximum test duration {} reached: {}", human_duration(tc.max_duration_ns), open));
+    }
+  }
+
+ private:
+  std::string rel(int64_t t) const { return human_duration(t - exec_.inject_ns); }
+
+  // The control-flow path the coming scan takes, as a hash of the program's branch ids.
+  void path_of_scan(rt::Runtime& r) {
+    const auto& taken = r.probe_branches();
+    branches_.clear();
+    uint64_t h = 1469598103934665603ull;
+    for (size_t w = 0; w < taken.size(); ++w) {
+      uint64_t bits = taken[w];
+      while (bits) {
+        uint32_t b = static_cast<uint32_t>(w * 64 + static_cast<size_t>(__builtin_ctzll(bits)));
+        bits &= bits - 1;
+        if (b < user_branch_.size() && user_branch_[b]) {
+          branches_.push_back(b);
+          for (int k = 0; k < 4; ++k) h = (h ^ ((b >> (8 * k)) & 0xff)) * 1099511628211ull;
+        }
+      }
+    }
+    hash_ = h;
+  }
+
+  void inject(rt::Runtime& r, size_t i) {
+    const TestCase& tc = cb_.cases[i];
+    faults::InjectionContext ctx;
+    ctx.ref = tc.target_ref;
+    ctx.baseline = tc.target_ref.area == 'I' ? tc.target_ref.get(r.raw_inputs()) : tc.target_ref.get(r.delivered_outputs());
+    ctx.inject_ns = r.now();
+    ctx.tick_ns = r.schedule().tick_ns();
+    ctx.seed = cb_.spec.seed * 1000003u + run_;
+    std::string err;
+    auto rule = faults::make_rule(tc.fault, ctx, &err);
+    if (!rule) {  // checked at generation already: a broken build, stop the campaign
+      error_ = tc.id + ": " + err;
+      done_ = true;
+      return;
+    }
+    if (tc.target_ref.area == 'I') {
+      r.input_overlay().add(std::move(rule));
+      r.reapply_input_overlay();
+    } else {
+      r.output_overlay().add(std::move(rule));
+    }
+    monitors_ = monitor::MonitorSet::create(*cb_.build->app, cb_.monitors, tc.first_req, tc.reqs, &err);
+    if (!monitors_) {
+      error_ = tc.id + ": " + err;
+      done_ = true;
+      return;
+    }
+    active_ = i;
+    injected_ = true;
+    state_ = 0;
+    start_time_.assign(tc.reqs, -1);
+    react_time_.assign(tc.reqs, -1);
+    ++paths_[i];
+    tested_.insert({i, hash_});
+    exec_ = Execution{};
+    exec_.case_id = tc.id;
+    exec_.case_index = i;
+    exec_.path = paths_[i];
+    exec_.path_hash = hash_;
+    exec_.branches = branches_;
+    exec_.run = run_;
+    exec_.inject_ns = r.now();
+    if (opt_.vcd && !opt_.out_dir.empty()) {
+      exec_.vcd = fmt::format("{}_path{}.vcd", tc.id, exec_.path);
+      trace_ = report::open_vcd((std::filesystem::path(opt_.out_dir) / exec_.vcd).string(), cb_.watch, &err);
+      if (!trace_) exec_.vcd.clear();
+    }
+  }
+
+  void finish(rt::Runtime& r, Outcome o, std::string reason) {
+    exec_.outcome = o;
+    exec_.reason = std::move(reason);
+    exec_.end_ns = r.now();
+    // Completion: withdraw the fault at once; the caller restarts program and plant.
+    r.input_overlay().clear();
+    r.output_overlay().clear();
+    if (trace_) {
+      std::string err;
+      trace_->close(&err);
+      trace_.reset();
+    }
+    monitors_.reset();
+    active_ = SIZE_MAX;
+    done_ = true;
+  }
+
+  CampaignBuild& cb_;
+  const DriverOptions& opt_;
+  std::vector<uint8_t> prev_;
+  std::vector<int> paths_;  // paths tested per case
+  std::set<std::pair<size_t, uint64_t>> tested_;
+  std::vector<bool> user_branch_;
+  std::vector<uint32_t> branches_;
+  uint64_t hash_ = 0;
+  uint64_t run_ = 0;
+  size_t active_ = SIZE_MAX;
+  bool done_ = false, injected_ = false;
+  uint64_t state_ = 0;
+  std::unique_ptr<monitor::MonitorSet> monitors_;
+  std::unique_ptr<report::TraceWriter> trace_;
+  std::vector<int64_t> start_time_, react_time_;
+  Execution exec_;
+  std::string error_;
+};
+
+}  // namespace
+
+bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOptions& opt, CampaignResult* out,
+                     std::string* err) {
+  auto wall0 = std::chrono::steady_clock::now();
+  const Campaign& c = cb.spec;
+  const st::Application& app = *cb.build->app;
+  rt::Runtime runtime(app, cb.schedule, backend);
+  PassiveDriver driver(cb, opt);
+  runtime.add_hooks(&driver);
+
+  Journal journal;
+  std::string fingerprint = campaign_fingerprint(cb);
+  Progress pr;
+  pr.cases = cb.cases.size();
+  if (!opt.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(opt.out_dir, ec);
+    if (ec) {
+      *err = opt.out_dir + ": cannot create the output folder: " + ec.message();
+      return false;
+    }
+    std::string path = (std::filesystem::path(opt.out_dir) / "results.jsonl").string();
+    JournalState st;
+    if (!journal.open(path, opt.resume, c.name, fingerprint, cb.cases, &st, err)) return false;
+    for (auto& e : st.executions) {
+      driver.mark_tested(e);
+      ++(e.outcome == Outcome::Pass ? pr.pass : pr.fail);
+      out->executions.push_back(e);
+    }
+    out->resumed = st.executions.size();
+    pr.run = st.next_run;
+    pr.campaign_ns = st.campaign_ns;
+    pr.scans = st.scans;
+  }
+  pr.executions = out->executions.size();
+
+  const int64_t tick = cb.schedule.tick_ns();
+  int64_t next_progress = pr.campaign_ns + 1'000'000'000;
+  while (true) {
+    if (driver.all_done()) {
+      out->end_reason = fmt::format("every case tested on {} path(s)", c.max_paths);
+      break;
+    }
+    if (pr.campaign_ns >= c.budget_ns) {
+      out->end_reason = fmt::format("time budget of {} spent", human_duration(c.budget_ns));
+      break;
+    }
+    uint64_t seed = c.seed + pr.run;
+    if (c.restart == RestartKind::Warm && pr.run > 0) runtime.warm_restart(seed);
+    else runtime.cold_restart(seed);
+    driver.begin_run(pr.run);
+    bool search_over = false;
+    while (!driver.done()) {
+      runtime.scan();
+      ++pr.scans;
+      pr.campaign_ns += tick;
+      if (!driver.active()) {
+        // Not testing: the run searches for a precondition on an untested path.
+        if (runtime.now() >= c.search_window_ns || runtime.stopped()) {
+          search_over = true;
+          break;
+        }
+        if (pr.campaign_ns >= c.budget_ns) break;
+      }
+      if (opt.on_progress && pr.campaign_ns >= next_progress) {
+        next_progress = pr.campaign_ns + 1'000'000'000;
+        pr.cases_tested = driver.cases_tested();
+        opt.on_progress(pr);
+      }
+    }
+    if (!driver.error().empty()) {
+      *err = "internal error: " + driver.error();
+      return false;
+    }
+    if (driver.done()) {
+      Execution e = driver.result();
+      ++(e.outcome == Outcome::Pass ? pr.pass : pr.fail);
+      pr.executions = out->executions.size() + 1;
+      pr.cases_tested = driver.cases_tested();
+      ++pr.run;
+      if (journal.is_open() && !journal.append(e, pr, err)) return false;
+      out->executions.push_back(e);
+      if (opt.on_verdict) opt.on_verdict(e, pr);
+      continue;
+    }
+    ++pr.run;
+    if (search_over) {
+      out->end_reason = runtime.stopped() ? "the program stopped outside a test: " + runtime.stop_reason()
+                                          : fmt::format("no untested case or path within the search window of {}",
+                                                        human_duration(c.search_window_ns));
+      break;
+    }
+  }
+  runtime.remove_hooks(&driver);
+  std::vector<bool> seen(cb.cases.size(), false);
+  for (const auto& e : out->executions) seen[e.case_index] = true;
+  for (size_t i = 0; i < seen.size(); ++i)
+    if (!seen[i]) out->not_reached.push_back(i);
+  pr.cases_tested = driver.cases_tested();
+  out->progress = pr;
+  out->wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return true;
+}
+
+bool run_campaign(CampaignBuild& cb, const DriverOptions& opt, CampaignResult* out, std::string* err) {
+  auto plant = plant::make_plant(cb.spec.plant, cb.spec.plant_config, err);
+  if (!plant) {
+    *err = cb.spec.path + ": plant: " + *err;
+    return false;
+  }
+  auto backend = io::SimBackend::create(*cb.build->app, std::move(plant), err);
+  if (!backend) {
+    *err = cb.spec.path + ": " + *err;
+    return false;
+  }
+  return run_campaign_on(cb, backend.get(), opt, out, err);
+}
+
+}  // namespace plcfi::campaign

@@ -1,0 +1,82 @@
+// The passive fault-injection driver. Before each scan it checks the preconditions of all
+// pending test cases (one generated program, one VM call); when a case's precondition
+// becomes true on a control-flow path not tested yet, it injects the case's fault into
+// the image overlay; after each scan the case's fault-class monitors decide PASS or
+// FAIL; then the fault is withdrawn, program and plant restart, and the search goes on
+// until every case is tested on up to max_paths paths, no new case/path turns up within
+// the search window, or the time budget is spent.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "generate.hpp"
+#include "runtime/backend.hpp"
+
+namespace plcfi::campaign {
+
+enum class Outcome { Pass, Fail, NotReached };
+const char* outcome_name(Outcome o);
+
+// One execution of a test case on one control-flow path.
+struct Execution {
+  std::string case_id;
+  size_t case_index = 0;
+  int path = 1;                    // 1, 2, ... in the order the paths were met
+  uint64_t path_hash = 0;          // of the program's branch ids taken in the injection scan
+  std::vector<uint32_t> branches;  // those branch ids
+  Outcome outcome = Outcome::Fail;
+  std::string reason;              // why FAIL; what was seen for PASS
+  uint64_t run = 0;                // run index (0-based); the run's seed is campaign seed + run
+  int64_t inject_ns = 0;           // times on the run's scan clock
+  int64_t start_ns = -1;           // the start condition first held (-1: never)
+  int64_t reaction_ns = -1;        // every class requirement met (-1: never)
+  int64_t end_ns = 0;
+  int64_t latency_ns = -1;         // reaction - start
+  std::string vcd;                 // trace of the test window (file name in the output folder)
+};
+
+struct Progress {
+  uint64_t run = 0, scans = 0;
+  int64_t campaign_ns = 0;  // scan-clock time used, all runs
+  size_t executions = 0, pass = 0, fail = 0;
+  size_t cases_tested = 0, cases = 0;
+};
+
+struct DriverOptions {
+  std::string out_dir;  // results.jsonl and the VCDs; empty: no files
+  bool resume = false;  // continue the journal in out_dir
+  bool vcd = true;
+  std::function<void(const Execution&, const Progress&)> on_verdict;
+  std::function<void(const Progress&)> on_progress;  // about every simulated second
+};
+
+struct CampaignResult {
+  std::vector<Execution> executions;  // in the order they ran (resumed ones first)
+  std::vector<size_t> not_reached;    // case indexes never injected
+  Progress progress;
+  size_t resumed = 0;                 // executions read back from the journal
+  std::string end_reason;             // "all cases tested", "search window ...", "budget ..."
+  double wall_s = 0;
+};
+
+// Runs the campaign on the offline plant model. Fails (false, *err) only on errors that
+// stop the campaign: an unusable plant, an unwritable output folder, a journal of another
+// campaign.
+bool run_campaign(CampaignBuild& cb, const DriverOptions& opt, CampaignResult* out, std::string* err);
+
+// The same driver on any backend (tests use synthetic plants).
+bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOptions& opt, CampaignResult* out,
+                     std::string* err);
+
+// The branch points (file:line) that set an execution's path apart from the other paths of
+// its case; empty when the case ran on one path.
+std::vector<std::string> distinguishing_branches(const CampaignBuild& cb, const std::vector<Execution>& all,
+                                                 const Execution& e);
+
+// A fingerprint of the generated test set; a journal written for another one is refused.
+std::string campaign_fingerprint(const CampaignBuild& cb);
+
+}  // namespace plcfi::campaign

@@ -1,0 +1,385 @@
+// Test-case generation and the one compilation of program, preconditions and monitors.
+#include "generate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+namespace plcfi::campaign {
+
+std::string TestCase::transition_ref() const { return scenario->id + "." + step->id + "." + transition->lifeline; }
+
+std::string st_duration(int64_t ns) {
+  if (ns % 1'000'000 == 0) return fmt::format("T#{}ms", ns / 1'000'000);
+  if (ns % 1'000 == 0) return fmt::format("T#{}us", ns / 1'000);
+  return fmt::format("T#{}ns", ns);
+}
+
+std::string human_duration(int64_t ns) {
+  if (ns >= 1'000'000'000 && ns % 10'000'000 == 0) return fmt::format("{:g} s", static_cast<double>(ns) * 1e-9);
+  if (ns % 1'000'000 == 0) return fmt::format("{} ms", ns / 1'000'000);
+  return fmt::format("{:g} ms", static_cast<double>(ns) * 1e-6);
+}
+
+std::string address_text(const rt::ImageRef& r) {
+  if (r.is_bit) return fmt::format("%{}X{}.{}", r.area, r.offset, r.bit);
+  char size = r.size == 1 ? 'B' : r.size == 2 ? 'W' : r.size == 4 ? 'D' : 'L';
+  return fmt::format("%{}{}{}", r.area, size, r.offset / r.size);
+}
+
+namespace {
+
+constexpr const char* kPreProgram = "__FI_PRECONDITIONS";
+
+bool is_bool(const st::Type* t) { return t && t->kind == st::TypeKind::Bool; }
+
+// Integer range of a location type (analog comparisons clamp their bounds to it).
+std::pair<double, double> type_range(const st::Type* t) {
+  if (!t || (!t->is_integer() && !t->is_bitstring())) return {-1e300, 1e300};
+  double bits = 8.0 * t->size;
+  if (t->is_signed()) return {-std::pow(2.0, bits - 1), std::pow(2.0, bits - 1) - 1};
+  return {0, std::pow(2.0, bits) - 1};
+}
+
+bool parse_number(const std::string& s, double* v) {
+  try {
+    size_t used = 0;
+    *v = std::stod(s, &used);
+    return used == s.size();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+// ST text of "lifeline has value v" (analog: within tolerance).
+std::string state_expr(const Lifeline& l, const st::VarHandle& h, const std::string& value, double tol, std::string* human) {
+  double v = 0;
+  if (tol > 0 && !is_bool(h.type) && parse_number(value, &v) && h.type && (h.type->is_integer() || h.type->is_bitstring())) {
+    auto [lo, hi] = type_range(h.type);
+    double a = std::max(lo, std::ceil(v - tol)), b = std::min(hi, std::floor(v + tol));
+    *human = fmt::format("{} = {} +/- {}", l.name, value, tol);
+    return fmt::format("({} >= {} AND {} <= {})", l.bind, static_cast<int64_t>(a), l.bind, static_cast<int64_t>(b));
+  }
+  if (tol > 0 && h.type && h.type->is_real() && parse_number(value, &v)) {
+    *human = fmt::format("{} = {} +/- {}", l.name, value, tol);
+    return fmt::format("({} >= {} AND {} <= {})", l.bind, v - tol, l.bind, v + tol);
+  }
+  if (is_bool(h.type)) {
+    std::string up = st::canon(value);
+    if (up == "TRUE" || up == "1") {
+      *human = l.name;
+      return "(" + l.bind + ")";
+    }
+    if (up == "FALSE" || up == "0") {
+      *human = "NOT " + l.name;
+      return "(NOT " + l.bind + ")";
+    }
+  }
+  *human = l.name + " = " + value;
+  return "(" + l.bind + " = " + value + ")";
+}
+
+std::string substitute(std::string text, const std::map<std::string, std::string>& vars) {
+  for (const auto& [k, v] : vars) {
+    std::string key = "{" + k + "}";
+    for (size_t p = text.find(key); p != std::string::npos; p = text.find(key, p + v.size())) text.replace(p, key.size(), v);
+  }
+  return text;
+}
+
+// Rewrites diagnostics located in the generated precondition program to the TSD step
+// they come from (the generated text is one line per case).
+void remap_preconditions(st::Build& b, const std::vector<TestCase>& cases, const std::string& tsd_path) {
+  uint32_t gen = UINT32_MAX, tsd = UINT32_MAX;
+  for (uint32_t f = 0; f < b.sm.size(); ++f)
+    if (b.sm.file(f).path == "<preconditions>") gen = f;
+  std::string e;
+  if (gen == UINT32_MAX || !b.sm.load(tsd_path, &tsd, &e)) return;
+  auto& diags = const_cast<std::vector<st::Diagnostic>&>(b.diags.all());
+  for (auto& d : diags) {
+    if (d.loc.file != gen) continue;
+    size_t idx = d.loc.line >= 4 ? d.loc.line - 4 : SIZE_MAX;
+    if (idx >= cases.size()) continue;
+    const TestCase& c = cases[idx];
+    d.message += " (in the precondition of " + c.scenario->id + "." + c.step->id + ": " + c.precondition + ")";
+    const Loc& at = c.step->pre.empty() ? c.step->loc : c.step->pre.front().loc;
+    d.loc = st::SourceLoc{tsd, at.line, at.col};
+  }
+}
+
+// A class formula is compiled once per test case, with that case's values in place of the
+// placeholders: point each message at the formula's start (columns after a placeholder
+// would not match the file) and report it once.
+void tidy_class_diagnostics(st::Build& b, const FaultClasses& classes) {
+  uint32_t file = UINT32_MAX;
+  for (uint32_t f = 0; f < b.sm.size(); ++f)
+    if (b.sm.file(f).path == classes.path) file = f;
+  if (file == UINT32_MAX) return;
+  std::map<uint32_t, uint32_t> formula_col;  // line -> column of the formula's text
+  for (const auto& c : classes.classes) {
+    for (const auto& r : c.requirements)
+      for (const auto* f : {&r.trigger, &r.invariant, &r.final, &r.delay, &r.reaction, &r.release})
+        if (f->line) formula_col[f->line] = f->col;
+    for (const auto& fb : c.forbidden) formula_col[fb.formula.line] = fb.formula.col;
+  }
+  auto& diags = const_cast<std::vector<st::Diagnostic>&>(b.diags.all());
+  for (auto& d : diags) {
+    if (d.loc.file != file) continue;
+    auto it = formula_col.find(d.loc.line);
+    if (it != formula_col.end()) d.loc.col = it->second;
+  }
+  b.diags.remove_duplicates();
+}
+
+}  // namespace
+
+std::string precondition_program(const std::vector<TestCase>& cases) {
+  std::string s = fmt::format("PROGRAM {}\nVAR_OUTPUT pre : ARRAY[0..{}] OF BOOL; END_VAR\n(* one line per test case *)\n",
+                              kPreProgram, cases.empty() ? 0 : cases.size() - 1);
+  for (size_t i = 0; i < cases.size(); ++i) s += fmt::format("pre[{}] := {};\n", i, cases[i].precondition);
+  s += "END_PROGRAM\n";
+  return s;
+}
+
+bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
+  out->spec = std::move(spec);
+  const Campaign& c = out->spec;
+  st::CompileOptions opt;
+  opt.warnings = false;
+
+  // 1. The program alone: bindings, alarms and fault targets are checked against it.
+  auto prog = st::build_files(c.programs, opt);
+  if (!prog->ok()) {
+    *err = "";
+    for (const auto& e : prog->io_errors) *err += e + "\n";
+    *err += prog->diags.render_all();
+    return false;
+  }
+  const st::Application& papp = *prog->app;
+  std::map<std::string, st::VarHandle> binds;
+  for (const auto& l : c.tsd.lifelines) {
+    std::string e;
+    auto h = st::resolve(papp, l.bind, &e);
+    if (!h) {
+      *err = l.bind_loc.str() + ": lifeline " + l.name + ": " + e;
+      return false;
+    }
+    if (!h->type || !h->type->is_elementary()) {
+      *err = l.bind_loc.str() + ": lifeline " + l.name + ": '" + l.bind + "' is not an elementary value";
+      return false;
+    }
+    binds[l.name] = *h;
+  }
+  std::set<std::string> alarm_paths;
+  for (const auto& r : c.fmea.rows) {
+    std::string e;
+    auto h = st::resolve(papp, r.alarm, &e);
+    if (!h) {
+      *err = r.alarm_loc.str() + ": alarm: " + e;
+      return false;
+    }
+    if (!is_bool(h->type)) {
+      *err = r.alarm_loc.str() + ": alarm '" + r.alarm + "' is not a BOOL";
+      return false;
+    }
+    alarm_paths.insert(r.alarm);
+  }
+
+  // 2. One case per FMEA row, on the transition it names.
+  std::vector<TestCase> cases;
+  for (const auto& r : c.fmea.rows) {
+    TestCase tc;
+    tc.row = &r;
+    tc.rpn = r.rpn;
+    std::string sc, stp, ll;
+    split_transition_ref(r.transition, &sc, &stp, &ll);  // checked by check_references
+    for (const auto& s : c.tsd.scenarios)
+      if (s.id == sc) tc.scenario = &s;
+    for (const auto& s : tc.scenario->steps)
+      if (s.id == stp) tc.step = &s;
+    for (const auto& t : tc.step->transitions)
+      if (t.lifeline == ll) tc.transition = &t;
+    tc.cls = c.classes.find(r.fault_class);
+
+    // Precondition: the lifeline states, and the step's condition.
+    std::string expr, human;
+    for (const auto& ps : tc.step->pre) {
+      const Lifeline* l = c.tsd.find(ps.lifeline);
+      std::string h;
+      expr += (expr.empty() ? "" : " AND ") + state_expr(*l, binds[l->name], ps.value, l->tolerance, &h);
+    }
+    if (!tc.step->condition.empty()) expr += " AND (" + tc.step->condition + ")";
+    tc.precondition = expr;
+    tc.start = tc.step->start.empty() ? "TRUE" : tc.step->start;
+
+    // Fault: the transition's lifeline, or "Lifeline: model" for another one.
+    std::string model = r.fault_model;
+    uint32_t model_col = r.fault_loc.col;
+    tc.target = c.tsd.find(tc.transition->lifeline);
+    size_t colon = model.find(':');
+    if (colon != std::string::npos) {
+      std::string name = model.substr(0, colon);
+      name.erase(name.find_last_not_of(' ') + 1);
+      tc.target = c.tsd.find(name);
+      if (!tc.target) {
+        *err = r.fault_loc.str() + ": unknown lifeline '" + name + "' in the fault model";
+        return false;
+      }
+      size_t b = model.find_first_not_of(' ', colon + 1);
+      model_col += static_cast<uint32_t>(b == std::string::npos ? model.size() : b);
+      model = b == std::string::npos ? "" : model.substr(b);
+    }
+    std::string e;
+    if (!rt::parse_image_ref(papp, tc.target->bind, &tc.target_ref, &e)) {
+      *err = r.fault_loc.str() + ": lifeline " + tc.target->name + " (" + tc.target->bind +
+             ") is not an I/O address, so no fault can act on it: " + e;
+      return false;
+    }
+    tc.target_ref.text = address_text(tc.target_ref);
+    if (model.empty()) model = is_bool(tc.target_ref.type) ? "stuck" : "frozen";
+    uint32_t ecol = 0;
+    if (!faults::parse_fault(model, &tc.fault, &e, &ecol)) {
+      *err = fmt::format("{}:{}:{}: {}", r.fault_loc.file, r.fault_loc.line, model_col + ecol, e);
+      return false;
+    }
+    faults::InjectionContext ctx;
+    ctx.ref = tc.target_ref;
+    ctx.tick_ns = 10'000'000;
+    if (!faults::make_rule(tc.fault, ctx, &e)) {
+      *err = r.fault_loc.str() + ": " + e;
+      return false;
+    }
+    tc.deadline_ns = tc.transition->max_ns + tc.cls->reaction_time_ns;
+    tc.max_duration_ns = tc.cls->max_duration_ns;
+    cases.push_back(std::move(tc));
+  }
+  std::stable_sort(cases.begin(), cases.end(), [](const TestCase& a, const TestCase& b) { return a.rpn > b.rpn; });
+
+  // 3. Monitors: the class requirements with this case's values, then the forbidden
+  // reactions (an invariant that must hold for the whole test).
+  out->monitors.path = c.classes.path;
+  for (size_t i = 0; i < cases.size(); ++i) {
+    TestCase& tc = cases[i];
+    tc.id = fmt::format("TC{}", i + 1);
+    std::map<std::string, std::string> vars = {{"alarm", tc.row->alarm},
+                                               {"start", tc.start},
+                                               {"deadline", st_duration(tc.deadline_ns)},
+                                               {"signal", tc.target->bind}};
+    tc.first_req = out->monitors.requirements.size();
+    std::string reaction;
+    for (const auto& cr : tc.cls->requirements) {
+      monitor::RequirementSpec r;
+      r.id = tc.id + "." + cr.id;
+      r.text = substitute(cr.text, vars);
+      r.severity = "class " + tc.cls->id;
+      std::pair<const monitor::FormulaSource*, monitor::FormulaSource*> fs[] = {
+          {&cr.trigger, &r.trigger}, {&cr.invariant, &r.invariant}, {&cr.final, &r.final},
+          {&cr.delay, &r.delay},     {&cr.reaction, &r.reaction},   {&cr.release, &r.release}};
+      for (auto& [src, dst] : fs) {
+        *dst = *src;
+        dst->text = substitute(src->text, vars);
+      }
+      if (r.reaction.text != "TRUE") reaction += (reaction.empty() ? "" : "; ") + r.reaction.text;
+      out->monitors.requirements.push_back(r);
+    }
+    for (size_t k = 0; k < tc.cls->forbidden.size(); ++k) {
+      const Forbidden& fb = tc.cls->forbidden[k];
+      monitor::RequirementSpec r;
+      r.id = fmt::format("{}.forbidden{}", tc.id, k + 1);
+      r.text = fb.text.empty() ? "forbidden: " + fb.formula.text : substitute(fb.text, vars);
+      r.severity = "forbidden";
+      r.trigger.text = "TRUE";
+      r.invariant = fb.formula;
+      r.invariant.text = "NOT (" + substitute(fb.formula.text, vars) + ")";
+      // "NOT (" shifts the formula by five columns in error messages; point at its start.
+      r.final.text = "FALSE";
+      r.delay.text = "TRUE";
+      r.reaction.text = "TRUE";
+      r.release.text = "FALSE";
+      out->monitors.requirements.push_back(r);
+      ++tc.forbidden;
+    }
+    tc.reqs = out->monitors.requirements.size() - tc.first_req;
+    tc.expected = fmt::format("{} within {} of {}", reaction.empty() ? "(class requirements)" : reaction,
+                              human_duration(tc.deadline_ns), tc.step->start.empty() ? "the precondition" : tc.start);
+  }
+  out->cases = std::move(cases);
+
+  // 4. Everything in one build.
+  out->monitor_source = monitor::generate_monitors(out->monitors);
+  out->preconditions_source = precondition_program(out->cases);
+  st::NamedSources late = {{"<preconditions>", out->preconditions_source},
+                           {out->monitor_source.name, out->monitor_source.text}};
+  out->build = st::build_files(c.programs, opt, late);
+  monitor::remap_diagnostics(*out->build, out->monitor_source, out->monitors);
+  tidy_class_diagnostics(*out->build, c.classes);
+  remap_preconditions(*out->build, out->cases, c.tsd.path);
+  if (!out->build->ok()) {
+    *err = out->build->diags.render_all();
+    return false;
+  }
+  const st::Application& app = *out->build->app;
+  const st::Symbol* pre = nullptr;
+  for (const auto& o : app.observers)
+    if (o.name == kPreProgram) {
+      out->preconditions_entry = o.pou->entry;
+      out->preconditions_addr = o.addr;
+      pre = o.pou->find_var("pre");
+    }
+  if (!pre) {
+    *err = "internal: the precondition program is missing from the build";
+    return false;
+  }
+  // The fault targets again, against this build (the first one, and its types, are gone).
+  for (auto& tc : out->cases) {
+    std::string e;
+    if (!rt::parse_image_ref(app, tc.target->bind, &tc.target_ref, &e)) {
+      *err = "internal: " + e;
+      return false;
+    }
+    tc.target_ref.text = address_text(tc.target_ref);
+  }
+  out->preconditions.path = std::string(kPreProgram) + ".pre";
+  out->preconditions.type = pre->type;
+  out->preconditions.addr = out->preconditions_addr + pre->offset;
+  std::string e;
+
+  bool ok = app.has_configuration ? out->schedule.from_configuration(app, &e)
+                                  : out->schedule.single_program(app, "", c.cycle_ns ? c.cycle_ns : 10'000'000, &e);
+  if (!ok) {
+    *err = c.path + ": " + e;
+    return false;
+  }
+  if (c.cycle_ns && app.has_configuration && c.cycle_ns != out->schedule.tick_ns()) {
+    *err = fmt::format("{}: cycle {} differs from the base tick {} of the program's CONFIGURATION", c.path,
+                       human_duration(c.cycle_ns), human_duration(out->schedule.tick_ns()));
+    return false;
+  }
+
+  // The program's own files (branch points elsewhere, e.g. in the standard library, do
+  // not define a control-flow path of the program).
+  for (uint32_t f = 0; f < app.file_paths.size(); ++f)
+    for (const auto& p : c.programs)
+      if (std::filesystem::path(app.file_paths[f]).lexically_normal() == std::filesystem::path(p).lexically_normal())
+        out->program_files.push_back(f);
+
+  for (const auto& l : c.tsd.lifelines) {
+    auto h = st::resolve(app, l.bind, &e);
+    if (h) {
+      h->path = l.name;
+      out->watch.push_back(*h);
+    }
+  }
+  for (const auto& a : alarm_paths) {
+    auto h = st::resolve(app, a, &e);
+    if (h) out->watch.push_back(*h);
+  }
+  return true;
+}
+
+}  // namespace plcfi::campaign

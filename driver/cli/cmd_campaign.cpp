@@ -1,0 +1,337 @@
+// plcfi generate / plcfi campaign: test cases from TSD and FMEA, and the passive
+// fault-injection campaign on the plant model.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <unistd.h>
+
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+#include "campaign/driver.hpp"
+#include "campaign/generate.hpp"
+#include "commands.hpp"
+#include "json.hpp"
+#include "report/junit.hpp"
+#include "report/puml.hpp"
+
+namespace po = boost::program_options;
+
+namespace plcfi::cli {
+
+namespace {
+
+using campaign::CampaignBuild;
+using campaign::TestCase;
+
+std::string fault_text(const TestCase& tc) {
+  return fmt::format("{} ({}): {}", tc.target->name, tc.target_ref.text, tc.fault.text);
+}
+
+std::string pad(std::string s, size_t n) {
+  if (s.size() > n) return s.substr(0, n - 1) + "~";
+  s.resize(n, ' ');
+  return s;
+}
+
+report::PumlCase puml_case(const CampaignBuild& cb, const TestCase& tc) {
+  report::PumlCase p;
+  p.id = tc.id;
+  p.title = tc.transition_ref() + ": " + tc.row->failure_mode;
+  p.precondition = tc.precondition;
+  p.start = tc.step->start;
+  p.target = tc.target->name + " (" + tc.target_ref.text + ")";
+  p.fault = tc.fault.text;
+  p.reaction = tc.expected;
+  p.deadline_ns = tc.deadline_ns;
+  p.max_duration_ns = tc.max_duration_ns;
+  p.fault_class = tc.cls->id + (tc.cls->name.empty() ? "" : " " + tc.cls->name);
+  p.restart = cb.spec.restart == campaign::RestartKind::Cold ? "cold" : "warm";
+  p.rpn = tc.rpn;
+  for (const auto& t : tc.step->transitions) {
+    report::PumlTransition x;
+    x.lifeline = t.lifeline;
+    x.to = t.to;
+    std::string up = st::canon(t.to);
+    x.from = up == "TRUE" ? "FALSE" : up == "FALSE" ? "TRUE" : "before";
+    for (const auto& ps : tc.step->pre)
+      if (ps.lifeline == t.lifeline) x.from = ps.value;
+    x.faulted = &t == tc.transition;
+    x.min_ns = t.min_ns;
+    x.max_ns = t.max_ns;
+    const auto* l = cb.spec.tsd.find(t.lifeline);
+    x.tolerance = t.tolerance >= 0 ? t.tolerance : (l ? l->tolerance : 0);
+    p.transitions.push_back(x);
+  }
+  return p;
+}
+
+bool write_diagrams(const CampaignBuild& cb, const std::string& dir, std::string* err) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    *err = dir + ": " + ec.message();
+    return false;
+  }
+  for (const auto& tc : cb.cases) {
+    auto p = puml_case(cb, tc);
+    for (const auto& [suffix, text] : {std::pair{"sequence", report::sequence_diagram(p)}, {"timing", report::timing_diagram(p)}}) {
+      std::string path = (std::filesystem::path(dir) / fmt::format("{}_{}.puml", tc.id, suffix)).string();
+      std::ofstream f(path);
+      f << text;
+      if (!f) {
+        *err = path + ": cannot write";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+// Loads and generates; prints errors and returns false (exit 2) when the specs are bad.
+bool load_and_prepare(const std::string& path, const std::vector<std::string>& programs, const uint64_t* seed,
+                      CampaignBuild* cb) {
+  campaign::Campaign spec;
+  std::string err;
+  if (!campaign::load_campaign(path, &spec, &err)) {
+    std::cerr << err << "\n";
+    return false;
+  }
+  if (!programs.empty()) spec.programs = programs;
+  if (seed) spec.seed = *seed;
+  if (!campaign::prepare_campaign(std::move(spec), cb, &err)) {
+    std::cerr << err << (err.empty() || err.back() == '\n' ? "" : "\n");
+    return false;
+  }
+  return true;
+}
+
+void print_cases(const CampaignBuild& cb) {
+  const auto& c = cb.spec;
+  std::cout << fmt::format("campaign {}: {} test case(s) from {} and {}\n", c.name, cb.cases.size(), c.fmea.path, c.tsd.path);
+  std::cout << fmt::format("  program {}, plant {}, base tick {}, classes {}\n\n", c.programs.back(), c.plant,
+                           campaign::human_duration(cb.schedule.tick_ns()), c.classes.path);
+  std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad("case", 5), pad("RPN", 4), pad("FMEA", 5), pad("class", 6),
+                           pad("transition", 30), pad("fault", 40), "deadline");
+  for (const auto& tc : cb.cases)
+    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad(std::to_string(tc.rpn), 4), pad(tc.row->id, 5),
+                             pad(tc.cls->id, 6), pad(tc.transition_ref(), 30), pad(fault_text(tc), 40),
+                             campaign::human_duration(tc.deadline_ns));
+  std::cout << "\n";
+  for (const auto& tc : cb.cases) {
+    std::cout << fmt::format("{}: {}\n", tc.id, tc.row->failure_mode);
+    std::cout << fmt::format("  precondition  {}\n", tc.precondition);
+    std::cout << fmt::format("  start         {}\n", tc.step->start.empty() ? "previous transition (the precondition)" : tc.start);
+    std::cout << fmt::format("  expected      {}\n", tc.expected);
+    for (size_t k = tc.first_req + tc.reqs - tc.forbidden; k < tc.first_req + tc.reqs; ++k)
+      std::cout << fmt::format("  forbidden     {}\n", cb.monitors.requirements[k].text);
+  }
+}
+
+std::string json_cases(const CampaignBuild& cb) {
+  std::string o = "[\n";
+  for (size_t i = 0; i < cb.cases.size(); ++i) {
+    const auto& tc = cb.cases[i];
+    o += fmt::format(
+        "  {{\"id\": \"{}\", \"fmea\": \"{}\", \"rpn\": {}, \"fault_class\": \"{}\", \"transition\": \"{}\", "
+        "\"failure_mode\": \"{}\", \"precondition\": \"{}\", \"start\": \"{}\", \"target\": \"{}\", \"address\": \"{}\", "
+        "\"fault\": \"{}\", \"alarm\": \"{}\", \"expected\": \"{}\", \"deadline_ms\": {}, \"max_duration_ms\": {}}}{}\n",
+        json_escape(tc.id), json_escape(tc.row->id), tc.rpn, json_escape(tc.cls->id), json_escape(tc.transition_ref()),
+        json_escape(tc.row->failure_mode), json_escape(tc.precondition), json_escape(tc.start), json_escape(tc.target->name),
+        json_escape(tc.target_ref.text), json_escape(tc.fault.text), json_escape(tc.row->alarm), json_escape(tc.expected),
+        static_cast<double>(tc.deadline_ns) * 1e-6, static_cast<double>(tc.max_duration_ns) * 1e-6,
+        i + 1 < cb.cases.size() ? "," : "");
+  }
+  return o + "]\n";
+}
+
+// Parses the common arguments; returns 0 to go on, else the exit status (help, usage).
+int parse(const std::string& cmd, const std::string& usage, po::options_description& desc, const std::vector<std::string>& args,
+          po::variables_map* vm) {
+  desc.add_options()("help,h", "show this help");
+  po::options_description all;
+  all.add(desc);
+  all.add_options()("campaign-file", po::value<std::vector<std::string>>(), "");
+  po::positional_options_description pos;
+  pos.add("campaign-file", -1);
+  po::store(po::command_line_parser(args).options(all).positional(pos).run(), *vm);
+  po::notify(*vm);
+  if (vm->count("help")) {
+    std::cout << "usage: " << usage << "\n\n" << desc << "\n";
+    return -1;
+  }
+  if (!vm->count("campaign-file") || (*vm)["campaign-file"].as<std::vector<std::string>>().size() != 1) {
+    std::cerr << "plcfi " << cmd << ": expected one campaign file\nusage: " << usage << "\n";
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int cmd_generate(const std::vector<std::string>& args) {
+  const std::string usage = "plcfi generate CAMPAIGN.yaml [--json] [--puml DIR] [--program FILE...]";
+  po::options_description desc("plcfi generate: the prioritized test set of a campaign (one case per TSD transition with an FMEA row)");
+  desc.add_options()
+      ("json", "print the test cases as JSON")
+      ("puml", po::value<std::string>(), "write a PlantUML sequence and timing diagram per case into DIR")
+      ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's");
+  po::variables_map vm;
+  if (int s = parse("generate", usage, desc, args, &vm)) return s < 0 ? 0 : s;
+  CampaignBuild cb;
+  std::vector<std::string> programs;
+  if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
+  if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, nullptr, &cb)) return 2;
+  if (vm.count("json")) std::cout << json_cases(cb);
+  else print_cases(cb);
+  if (vm.count("puml")) {
+    std::string err;
+    if (!write_diagrams(cb, vm["puml"].as<std::string>(), &err)) {
+      std::cerr << "plcfi generate: " << err << "\n";
+      return 2;
+    }
+    if (!vm.count("json"))
+      std::cout << fmt::format("\nwrote {} diagrams to {}\n", 2 * cb.cases.size(), vm["puml"].as<std::string>());
+  }
+  return 0;
+}
+
+int cmd_campaign(const std::vector<std::string>& args) {
+  const std::string usage =
+      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--seed N] [--no-vcd] [--quiet]";
+  po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time)");
+  desc.add_options()
+      ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
+      ("resume", "finish a campaign whose journal is in the output folder (no case runs twice)")
+      ("junit", po::value<std::string>(), "write JUnit XML")
+      ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
+      ("seed", po::value<uint64_t>(), "seed instead of the campaign's")
+      ("no-vcd", "no VCD trace per test")
+      ("quiet", "no live progress line");
+  po::variables_map vm;
+  if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
+  CampaignBuild cb;
+  std::vector<std::string> programs;
+  if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
+  uint64_t seed = vm.count("seed") ? vm["seed"].as<uint64_t>() : 0;
+  if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, vm.count("seed") ? &seed : nullptr, &cb))
+    return 2;
+  const auto& c = cb.spec;
+  std::string out = vm.count("out") ? vm["out"].as<std::string>()
+                                    : (std::filesystem::path("plcfi-out") /
+                                       (c.name + "-" + std::filesystem::path(c.programs.back()).stem().string()))
+                                          .string();
+  std::string err;
+  if (!write_diagrams(cb, (std::filesystem::path(out) / "diagrams").string(), &err)) {
+    std::cerr << "plcfi campaign: " << err << "\n";
+    return 2;
+  }
+  std::cout << fmt::format("plcfi campaign {}: {} test case(s), program {}, plant {}, seed {}\n", c.name, cb.cases.size(),
+                           c.programs.back(), c.plant, c.seed);
+  bool live = !vm.count("quiet") && isatty(STDERR_FILENO);
+  campaign::DriverOptions opt;
+  opt.out_dir = out;
+  opt.resume = vm.count("resume") > 0;
+  opt.vcd = !vm.count("no-vcd");
+  auto progress_line = [&](const campaign::Progress& p) {
+    if (!live) return;
+    std::cerr << fmt::format("\r  run {:>3}  cases tested {}/{}  PASS {}  FAIL {}  t = {:.1f} s   ", p.run, p.cases_tested,
+                             p.cases, p.pass, p.fail, static_cast<double>(p.campaign_ns) * 1e-9)
+              << std::flush;
+  };
+  opt.on_progress = progress_line;
+  opt.on_verdict = [&](const campaign::Execution& e, const campaign::Progress& p) {
+    if (live) std::cerr << "\r" << std::string(72, ' ') << "\r";
+    const auto& tc = cb.cases[e.case_index];
+    std::cout << fmt::format("  [run {:>2}, t={:7.3f} s] {} path {} {}: {}\n", e.run, static_cast<double>(e.inject_ns) * 1e-9, e.case_id,
+                             e.path, campaign::outcome_name(e.outcome), tc.transition_ref())
+              << std::flush;
+    progress_line(p);
+  };
+  campaign::CampaignResult res;
+  if (!campaign::run_campaign(cb, opt, &res, &err)) {
+    if (live) std::cerr << "\n";
+    std::cerr << "plcfi campaign: " << err << "\n";
+    return 2;
+  }
+  if (live) std::cerr << "\r" << std::string(72, ' ') << "\r";
+  if (res.resumed) std::cout << fmt::format("  resumed: {} verdict(s) read from {}/results.jsonl\n", res.resumed, out);
+
+  // Summary table.
+  std::cout << fmt::format("\n{} {} {} {} {} {} {}\n", pad("case", 5), pad("path", 5), pad("verdict", 12), pad("latency", 9),
+                           pad("RPN", 4), pad("transition", 30), "fault / reason");
+  size_t pass = 0, fail = 0;
+  for (const auto& e : res.executions) {
+    const auto& tc = cb.cases[e.case_index];
+    (e.outcome == campaign::Outcome::Pass ? pass : fail)++;
+    std::string lat = e.latency_ns >= 0 ? fmt::format("{:.0f} ms", static_cast<double>(e.latency_ns) * 1e-6) : "-";
+    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(e.case_id, 5), pad(std::to_string(e.path), 5),
+                             pad(campaign::outcome_name(e.outcome), 12), pad(lat, 9), pad(std::to_string(tc.rpn), 4),
+                             pad(tc.transition_ref(), 30), fault_text(tc));
+    if (e.outcome != campaign::Outcome::Pass) std::cout << fmt::format("{}{}\n", std::string(38, ' '), e.reason);
+    auto dist = campaign::distinguishing_branches(cb, res.executions, e);
+    if (!dist.empty()) {
+      std::string list;
+      for (const auto& d : dist) list += (list.empty() ? "" : ", ") + d;
+      std::cout << fmt::format("{}path: {}\n", std::string(38, ' '), list);
+    }
+  }
+  for (size_t i : res.not_reached) {
+    const auto& tc = cb.cases[i];
+    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad("-", 5), pad("NOT REACHED", 12), pad("-", 9),
+                             pad(std::to_string(tc.rpn), 4), pad(tc.transition_ref(), 30),
+                             "precondition never held: " + tc.precondition);
+  }
+  const auto& p = res.progress;
+  std::cout << fmt::format(
+      "\n{} execution(s) of {} case(s): {} PASS, {} FAIL, {} NOT REACHED\n", res.executions.size(), cb.cases.size(), pass,
+      fail, res.not_reached.size());
+  std::cout << fmt::format("{} run(s), {} scans, {:.1f} s on the scan clock in {:.3f} s wall time; ended: {}\n", p.run,
+                           p.scans, static_cast<double>(p.campaign_ns) * 1e-9, res.wall_s, res.end_reason);
+  std::cout << fmt::format("journal {}/results.jsonl, traces and diagrams in {}\n", out, out);
+
+  if (vm.count("junit")) {
+    report::JunitSuite suite;
+    suite.name = "campaign." + c.name;
+    for (const auto& e : res.executions) {
+      const auto& tc = cb.cases[e.case_index];
+      report::JunitCase jc;
+      jc.classname = suite.name + "." + tc.transition_ref();
+      jc.name = fmt::format("{} path {}: {}", e.case_id, e.path, tc.row->failure_mode);
+      jc.seconds = static_cast<double>(e.end_ns - e.inject_ns) * 1e-9;
+      jc.outcome = e.outcome == campaign::Outcome::Pass ? report::JunitCase::Outcome::Pass : report::JunitCase::Outcome::Fail;
+      if (e.outcome != campaign::Outcome::Pass) jc.message = e.reason;
+      jc.detail = fmt::format("precondition: {}\nfault: {}\nexpected: {}\nresult: {}", tc.precondition, fault_text(tc),
+                              tc.expected, e.reason);
+      std::string dist;
+      for (const auto& d : campaign::distinguishing_branches(cb, res.executions, e)) dist += (dist.empty() ? "" : ", ") + d;
+      jc.properties = {{"rpn", std::to_string(tc.rpn)},
+                       {"fault_class", tc.cls->id},
+                       {"fmea", tc.row->id},
+                       {"path", std::to_string(e.path)},
+                       {"path_branches", dist},
+                       {"fault", fault_text(tc)},
+                       {"latency_ms", e.latency_ns >= 0 ? fmt::format("{:.1f}", static_cast<double>(e.latency_ns) * 1e-6) : ""},
+                       {"vcd", e.vcd}};
+      suite.cases.push_back(jc);
+    }
+    for (size_t i : res.not_reached) {
+      const auto& tc = cb.cases[i];
+      report::JunitCase jc;
+      jc.classname = suite.name + "." + tc.transition_ref();
+      jc.name = fmt::format("{}: {}", tc.id, tc.row->failure_mode);
+      jc.outcome = report::JunitCase::Outcome::Skipped;
+      jc.message = "NOT REACHED: the precondition never held (coverage gap): " + tc.precondition;
+      jc.properties = {{"rpn", std::to_string(tc.rpn)}, {"fault_class", tc.cls->id}, {"fmea", tc.row->id}};
+      suite.cases.push_back(jc);
+    }
+    if (!report::write_junit(vm["junit"].as<std::string>(), {suite}, &err)) {
+      std::cerr << "plcfi campaign: " << err << "\n";
+      return 2;
+    }
+  }
+  return fail || !res.not_reached.empty() ? 1 : 0;
+}
+
+}  // namespace plcfi::cli
