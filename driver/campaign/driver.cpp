@@ -39,6 +39,8 @@ std::string campaign_fingerprint(const CampaignBuild& cb) {
   mix(cb.spec.name);
   mix(std::to_string(cb.spec.seed));
   mix(std::to_string(cb.spec.max_paths));
+  mix(cb.spec.restart == RestartKind::Cold ? "cold" : "warm");
+  mix(cb.spec.plant + "|" + cb.spec.plant_config);
   for (const auto& p : cb.spec.programs) {
     std::ifstream in(p);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -74,7 +76,7 @@ std::vector<std::string> distinguishing_branches(const CampaignBuild& cb, const 
     if (common.count(b) || b >= app.branches.size()) continue;
     const auto& bp = app.branches[b];
     std::string file = bp.loc.file < app.file_paths.size() ? app.file_paths[bp.loc.file] : "?";
-    out.push_back(fmt::format("{}:{} {}", std::filesystem::path(file).filename().string(), bp.loc.line, bp.kind));
+    out.push_back(fmt::format("{}:{} {} ({})", std::filesystem::path(file).filename().string(), bp.loc.line, bp.kind, bp.pou));
   }
   return out;
 }
@@ -278,6 +280,10 @@ class PassiveDriver final : public rt::ScanHooks {
   }
 
   void finish(rt::Runtime& r, Outcome o, std::string reason) {
+    const TestCase& tc = cb_.cases[active_];
+    if (exec_.start_ns < 0)  // a FAIL: still say when the class requirements' start held
+      for (size_t k = 0; k < tc.reqs - tc.forbidden; ++k)
+        if (start_time_[k] >= 0 && (exec_.start_ns < 0 || start_time_[k] < exec_.start_ns)) exec_.start_ns = start_time_[k];
     exec_.outcome = o;
     exec_.reason = std::move(reason);
     exec_.end_ns = r.now();

@@ -1,6 +1,8 @@
 // plcfi generate / plcfi campaign: test cases from TSD and FMEA, and the passive
 // fault-injection campaign on the plant model.
+#include <algorithm>
 #include <filesystem>
+#include <tuple>
 #include <fstream>
 #include <iostream>
 
@@ -262,7 +264,11 @@ int cmd_campaign(const std::vector<std::string>& args) {
   std::cout << fmt::format("\n{} {} {} {} {} {} {}\n", pad("case", 5), pad("path", 5), pad("verdict", 12), pad("latency", 9),
                            pad("RPN", 4), pad("transition", 30), "fault / reason");
   size_t pass = 0, fail = 0;
-  for (const auto& e : res.executions) {
+  std::vector<campaign::Execution> table = res.executions;  // by case, then path
+  std::stable_sort(table.begin(), table.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.case_index, a.path) < std::tie(b.case_index, b.path);
+  });
+  for (const auto& e : table) {
     const auto& tc = cb.cases[e.case_index];
     (e.outcome == campaign::Outcome::Pass ? pass : fail)++;
     std::string lat = e.latency_ns >= 0 ? fmt::format("{:.0f} ms", static_cast<double>(e.latency_ns) * 1e-6) : "-";

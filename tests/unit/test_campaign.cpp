@@ -312,6 +312,61 @@ TEST(CampaignStamping, UnreachablePreconditionIsNotReached) {
   EXPECT_EQ(cb.cases[r.not_reached[0]].row->id, "F8");
 }
 
+TEST(CampaignStamping, ForbiddenReactionFails) {
+  SpecCopy copy("forbidden");
+  // Class 2 forbids the warning lamp here: the warning itself lights it, in the very scan
+  // the reaction comes, so the case fails on the forbidden reaction.
+  copy.edit("fault_classes.yaml", "{formula: \"gStampStop\", text: \"a warning must not stop the module\"}",
+            "{formula: \"WarningLamp\", text: \"no warning lamp\"}");
+  CampaignBuild cb = prepare(copy.path("campaign.yaml"));
+  CampaignResult r;
+  DriverOptions opt;
+  std::string err;
+  ASSERT_TRUE(run_campaign(cb, opt, &r, &err)) << err;
+  auto v = verdicts_by_fmea(cb, r);
+  ASSERT_EQ(v["F8"].size(), 1u);
+  EXPECT_EQ(v["F8"][0], Outcome::Fail);
+  for (const auto& e : r.executions)
+    if (cb.cases[e.case_index].row->id == "F8") {
+      EXPECT_NE(e.reason.find("forbidden reaction at +"), std::string::npos) << e.reason;
+      EXPECT_NE(e.reason.find("no warning lamp"), std::string::npos) << e.reason;
+    }
+}
+
+TEST(CampaignStamping, MaximumTestDurationFails) {
+  SpecCopy copy("maxdur");
+  // The hand-over warning comes after 10 s; a class that gives up after 5 s fails it.
+  copy.edit("fault_classes.yaml", "  - id: 2\n    name: warning\n    text: \"Warning message, the module goes on\"\n    reaction_time: 100ms\n    max_duration: 30s",
+            "  - id: 2\n    name: warning\n    text: \"Warning message, the module goes on\"\n    reaction_time: 100ms\n    max_duration: 5s");
+  CampaignBuild cb = prepare(copy.path("campaign.yaml"));
+  CampaignResult r;
+  DriverOptions opt;
+  std::string err;
+  ASSERT_TRUE(run_campaign(cb, opt, &r, &err)) << err;
+  bool seen = false;
+  for (const auto& e : r.executions)
+    if (cb.cases[e.case_index].row->id == "F8") {
+      seen = true;
+      EXPECT_EQ(e.outcome, Outcome::Fail);
+      EXPECT_NE(e.reason.find("maximum test duration 5 s reached"), std::string::npos) << e.reason;
+      EXPECT_EQ(e.end_ns - e.inject_ns, 5'000'000'000);
+    }
+  EXPECT_TRUE(seen);
+}
+
+TEST(CampaignStamping, BudgetEndsTheCampaign) {
+  SpecCopy copy("budget");
+  copy.edit("campaign.yaml", "budget: 1h", "budget: 3s");
+  CampaignBuild cb = prepare(copy.path("campaign.yaml"));
+  CampaignResult r;
+  DriverOptions opt;
+  std::string err;
+  ASSERT_TRUE(run_campaign(cb, opt, &r, &err)) << err;
+  EXPECT_NE(r.end_reason.find("time budget of 3 s spent"), std::string::npos) << r.end_reason;
+  EXPECT_FALSE(r.not_reached.empty());  // what did not get its turn is reported, not passed
+  EXPECT_LT(r.executions.size(), cb.cases.size());
+}
+
 TEST(CampaignStamping, SameSeedSameJournal) {
   fs::path a = out_dir("det_a"), b = out_dir("det_b");
   for (const auto& dir : {a, b}) {
