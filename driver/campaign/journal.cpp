@@ -99,7 +99,17 @@ class LineParser {
         if (e == 'n') *out += '\n';
         else if (e == 'u') {
           if (i_ + 4 > s_.size()) return false;
-          *out += static_cast<char>(std::stoi(s_.substr(i_, 4), nullptr, 16));
+          int code = 0;
+          for (size_t k = 0; k < 4; ++k) {
+            char h = s_[i_ + k];
+            int d = std::isdigit(static_cast<unsigned char>(h)) ? h - '0'
+                    : (h >= 'a' && h <= 'f') ? h - 'a' + 10
+                    : (h >= 'A' && h <= 'F') ? h - 'A' + 10
+                                             : -1;
+            if (d < 0) return false;
+            code = code * 16 + d;
+          }
+          *out += static_cast<char>(code);
           i_ += 4;
         } else *out += e;
       } else {
@@ -213,7 +223,14 @@ bool Journal::open(const std::string& path, bool resume, const std::string& camp
         return false;
       }
       e.outcome = *verdict == "PASS" ? Outcome::Pass : Outcome::Fail;
-      e.path_hash = std::stoull(*hash, nullptr, 16);
+      try {
+        size_t used = 0;
+        e.path_hash = std::stoull(*hash, &used, 16);
+        if (used != hash->size()) throw std::invalid_argument(*hash);
+      } catch (const std::exception&) {
+        *err = fmt::format("{}:{}:1: path_hash '{}' is not hexadecimal", path, n, *hash);
+        return false;
+      }
       if (const int64_t* v = get_int(o, "path")) e.path = static_cast<int>(*v);
       if (auto it = o.find("branches"); it != o.end())
         if (auto* arr = std::get_if<std::vector<int64_t>>(&it->second))

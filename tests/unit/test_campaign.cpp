@@ -440,3 +440,31 @@ TEST(CampaignStamping, ResumeRefusesAnotherCampaignsJournal) {
   EXPECT_NE(err.find("belongs to another campaign"), std::string::npos) << err;
   fs::remove_all(dir);
 }
+
+TEST(CampaignStamping, ResumeReportsACorruptJournal) {
+  fs::path dir = out_dir("resume_corrupt");
+  {
+    CampaignBuild cb = prepare(kSpecDir / "campaign.yaml");
+    CampaignResult r;
+    DriverOptions opt;
+    opt.out_dir = dir.string();
+    std::string err;
+    ASSERT_TRUE(run_campaign(cb, opt, &r, &err)) << err;
+  }
+  std::string journal = read(dir / "results.jsonl");
+  std::string header = journal.substr(0, journal.find('\n') + 1);
+  for (const std::string& bad : {std::string("{\"case\":\"TC1\",\"verdict\":\"PASS\",\"path_hash\":\"zz\"}\n"),
+                                std::string("{\"case\":\"TC99\",\"verdict\":\"PASS\",\"path_hash\":\"00\"}\n"),
+                                std::string("not json at all\n")}) {
+    write(dir / "results.jsonl", header + bad);
+    CampaignBuild cb = prepare(kSpecDir / "campaign.yaml");
+    CampaignResult r;
+    DriverOptions opt;
+    opt.out_dir = dir.string();
+    opt.resume = true;
+    std::string err;
+    EXPECT_FALSE(run_campaign(cb, opt, &r, &err)) << bad;
+    EXPECT_NE(err.find("results.jsonl:2:1: "), std::string::npos) << err;
+  }
+  fs::remove_all(dir);
+}
