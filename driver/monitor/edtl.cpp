@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -195,6 +196,56 @@ const char* kOutputs[] = {"__o_trig", "__o_inv", "__o_fin", "__o_del", "__o_reac
 std::string program_name(size_t i) { return "__EDTL_" + std::to_string(i + 1); }
 }  // namespace
 
+namespace {
+
+// A temporal operator call cut out of a formula: its text and source columns.
+struct Hoisted {
+  std::string text;
+  std::vector<uint32_t> map;
+};
+
+bool ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// Finds the temporal operator call (RISING ... DECREASES, not PASSED) that starts last in
+// `t`: it contains no other one. Returns its [begin, end) or false.
+bool last_temporal_call(const std::string& t, size_t* begin, size_t* end) {
+  static const char* kOps[] = {"RISING", "FALLING", "HIGH", "LOW", "CHANGES", "INCREASES", "DECREASES"};
+  bool found = false;
+  for (size_t i = 0; i < t.size(); ++i) {
+    if (!std::isalpha(static_cast<unsigned char>(t[i])) || (i > 0 && (ident_char(t[i - 1]) || t[i - 1] == '.'))) continue;
+    size_t j = i;
+    while (j < t.size() && ident_char(t[j])) ++j;
+    std::string word = st::canon(t.substr(i, j - i));
+    bool op = false;
+    for (const char* k : kOps) op = op || word == k;
+    size_t k = j;
+    while (k < t.size() && std::isspace(static_cast<unsigned char>(t[k]))) ++k;
+    if (op && k < t.size() && t[k] == '(') {
+      // The matching parenthesis, skipping string literals.
+      int depth = 0;
+      size_t e = k;
+      for (; e < t.size(); ++e) {
+        if (t[e] == '\'') {
+          for (++e; e < t.size() && t[e] != '\''; ++e)
+            if (t[e] == '$') ++e;
+          continue;
+        }
+        if (t[e] == '(') ++depth;
+        if (t[e] == ')' && --depth == 0) break;
+      }
+      if (e < t.size()) {
+        *begin = i;
+        *end = e + 1;
+        found = true;
+      }
+    }
+    i = j - 1;
+  }
+  return found;
+}
+
+}  // namespace
+
 MonitorSource generate_monitors(const RequirementsFile& reqs) {
   MonitorSource src;
   src.name = "<monitors:" + reqs.path + ">";
@@ -202,24 +253,56 @@ MonitorSource generate_monitors(const RequirementsFile& reqs) {
     src.text += s + "\n";
     src.lines.emplace_back();
   };
+  auto mapped = [&](const std::string& s, const FormulaSource* f, std::vector<uint32_t> map) {
+    line(s);
+    src.lines.back().formula = f;
+    src.lines.back().pos_map = std::move(map);
+  };
   for (size_t i = 0; i < reqs.requirements.size(); ++i) {
     const auto& r = reqs.requirements[i];
-    line("PROGRAM " + program_name(i));
-    line("VAR_INPUT __elapsed : LTIME; __state : LINT; END_VAR");
-    line("VAR_OUTPUT __o_trig, __o_inv, __o_fin, __o_del, __o_react, __o_rel : BOOL; END_VAR");
     const FormulaSource* fs[] = {&r.trigger, &r.invariant, &r.final, &r.delay, &r.reaction, &r.release};
+    // Temporal operators keep per-state history, so they are computed every state in a
+    // prologue; the formulas read their results. That lets a step evaluate the trigger
+    // alone while no instance is open (__full = FALSE) without losing history.
+    std::string body[6];
+    std::vector<uint32_t> maps[6];
+    std::vector<std::pair<Hoisted, const FormulaSource*>> hoisted;
     for (int k = 0; k < 6; ++k) {
-      line(std::string(kOutputs[k]) + " := (");
-      std::vector<uint32_t> map;
-      std::string body = expand_symbols(fs[k]->text, &map);
+      body[k] = expand_symbols(fs[k]->text, &maps[k]);
       // A formula spans one generated line; newlines inside it are spaces.
-      for (char& c : body)
+      for (char& c : body[k])
         if (c == '\n' || c == '\r') c = ' ';
-      line(body);
-      src.lines.back().formula = fs[k];
-      src.lines.back().pos_map = std::move(map);
+      size_t b = 0, e = 0;
+      while (last_temporal_call(body[k], &b, &e)) {
+        Hoisted h{body[k].substr(b, e - b), std::vector<uint32_t>(maps[k].begin() + static_cast<long>(b), maps[k].begin() + static_cast<long>(e))};
+        std::string var = fmt::format("__e{}", hoisted.size() + 1);
+        uint32_t at = maps[k][b];
+        body[k].replace(b, e - b, var);
+        maps[k].erase(maps[k].begin() + static_cast<long>(b), maps[k].begin() + static_cast<long>(e));
+        maps[k].insert(maps[k].begin() + static_cast<long>(b), var.size(), at);
+        hoisted.emplace_back(std::move(h), fs[k]);
+      }
+    }
+    line("PROGRAM " + program_name(i));
+    line("VAR_INPUT __elapsed : LTIME; __state : LINT; __full : BOOL; END_VAR");
+    line("VAR_OUTPUT __o_trig, __o_inv, __o_fin, __o_del, __o_react, __o_rel : BOOL; END_VAR");
+    if (!hoisted.empty()) {
+      std::string vars;
+      for (size_t h = 0; h < hoisted.size(); ++h) vars += fmt::format("{}__e{}", h ? ", " : "", h + 1);
+      line("VAR " + vars + " : BOOL; END_VAR");
+    }
+    for (size_t h = 0; h < hoisted.size(); ++h) {
+      line(fmt::format("__e{} :=", h + 1));
+      mapped(hoisted[h].first.text, hoisted[h].second, hoisted[h].first.map);
+      line(";");
+    }
+    for (int k = 0; k < 6; ++k) {
+      if (k == 1) line("IF __full THEN");
+      line(std::string(kOutputs[k]) + " := (");
+      mapped(body[k], fs[k], maps[k]);
       line(");");
     }
+    line("END_IF;");
     line("END_PROGRAM");
   }
   return src;
@@ -286,6 +369,14 @@ std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const
     }
     const st::Symbol* el = inst->pou->find_var("__elapsed");
     const st::Symbol* sn = inst->pou->find_var("__state");
+    const st::Symbol* fu = inst->pou->find_var("__full");
+    if (!el || !sn || !fu || el->type->size != 8 || sn->type->size != 8) {
+      *err = "monitor " + name + " lacks its inputs";
+      return nullptr;
+    }
+    r.shift = inst->pou->shift.present ? &inst->pou->shift : nullptr;
+    r.full.type = fu->type;
+    r.full.addr = inst->addr + fu->offset;
     r.elapsed.type = el->type;
     r.elapsed.addr = inst->addr + el->offset;
     r.state.type = sn->type;
@@ -303,11 +394,34 @@ std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const
   return set;
 }
 
-bool MonitorSet::eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6]) {
-  st::write_int(m, r.elapsed, elapsed);
-  st::write_int(m, r.state, static_cast<int64_t>(state_));
+bool MonitorSet::eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6], bool full) {
+  // __elapsed (LTIME) and __state (LINT) are 8-byte slots, __full a BOOL byte.
+  int64_t st = static_cast<int64_t>(state_);
+  if (r.shift) {
+    // The shift to a new state, natively (the program would do the same in bytecode).
+    uint8_t* base = m.mem() + r.addr;
+    int64_t seen;
+    std::memcpy(&seen, base + r.shift->seen, 8);
+    if (seen != st) {
+      if (seen >= 0 && r.shift->started >= 0) base[r.shift->started] = 1;
+      for (const auto& mv : r.shift->moves) {
+        switch (mv[2]) {  // fixed sizes inline to single moves
+          case 1: base[mv[1]] = base[mv[0]]; break;
+          case 2: std::memcpy(base + mv[1], base + mv[0], 2); break;
+          case 4: std::memcpy(base + mv[1], base + mv[0], 4); break;
+          case 8: std::memcpy(base + mv[1], base + mv[0], 8); break;
+          default: std::memmove(base + mv[1], base + mv[0], mv[2]); break;
+        }
+      }
+      std::memcpy(base + r.shift->seen, &st, 8);
+    }
+  }
+  std::memcpy(m.mem() + r.elapsed.addr, &elapsed, 8);
+  std::memcpy(m.mem() + r.state.addr, &st, 8);
+  m.mem()[r.full.addr] = full ? 1 : 0;
   bool ok = m.call(r.entry, r.addr);
-  for (int k = 0; k < 6; ++k) v[k] = ok && m.mem()[r.out[k].addr] != 0;
+  const uint8_t* mem = m.mem();
+  for (int k = 0; k < (full ? 6 : 1); ++k) v[k] = ok && mem[r.out[k].addr] != 0;
   return ok;
 }
 
@@ -316,8 +430,11 @@ bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
   state_ = state;
   for (size_t ri = 0; ri < reqs_.size(); ++ri) {
     Req& r = reqs_[ri];
-    bool base[6];
-    eval(m, r, 0, base);
+    bool base[6] = {};
+    // While no instance is open only the trigger matters; a trigger (or an open instance)
+    // needs every formula at this state.
+    eval(m, r, 0, base, !r.groups.empty());
+    if (base[0] && r.groups.empty()) eval(m, r, 0, base, true);
     bool was_violated = r.verdict.violated();
     if (base[0]) {
       ++r.verdict.triggers;
@@ -334,7 +451,7 @@ bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
       bool done = false;
       const bool* val = base;
       if (r.uses_passed && !(g.timer_time == t)) {
-        eval(m, r, t - g.timer_time, v);
+        eval(m, r, t - g.timer_time, v, true);
         val = v;
       }
       if (!g.phase_b) {

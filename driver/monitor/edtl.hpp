@@ -116,12 +116,13 @@ class MonitorSet {
     const RequirementSpec* spec = nullptr;
     uint32_t entry = 0, addr = 0;
     st::VarHandle out[6];  // trig inv fin del react rel
-    st::VarHandle elapsed, state;
+    st::VarHandle elapsed, state, full;
+    const st::StateShift* shift = nullptr;
     bool uses_passed = false;
     std::vector<Group> groups;
     Verdict verdict;
   };
-  bool eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6]);
+  bool eval(st::Machine& m, Req& r, int64_t elapsed, bool v[6], bool full);
   std::vector<Req> reqs_;
   std::vector<size_t> newly_;
   uint64_t state_ = 0;

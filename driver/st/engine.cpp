@@ -339,13 +339,20 @@ void write_int(Machine& m, const VarHandle& h, int64_t v) {
     *p = static_cast<uint8_t>(v ? (*p | mask) : (*p & ~mask));
     return;
   }
-  switch (h.type->storage()) {
-    case Storage::I8: case Storage::U8: st<uint8_t>(p, static_cast<uint8_t>(h.type->kind == TypeKind::Bool ? v != 0 : v)); break;
-    case Storage::I16: case Storage::U16: st<uint16_t>(p, static_cast<uint16_t>(v)); break;
-    case Storage::I32: case Storage::U32: st<uint32_t>(p, static_cast<uint32_t>(v)); break;
-    case Storage::I64: case Storage::U64: st<uint64_t>(p, static_cast<uint64_t>(v)); break;
-    case Storage::F32: st<float>(p, static_cast<float>(v)); break;
-    case Storage::F64: st<double>(p, static_cast<double>(v)); break;
+  // The width decides for integers, enums, times and bits (the hot path of drivers and
+  // monitors); only the REAL types convert.
+  if (h.type->kind == TypeKind::Real) return st<float>(p, static_cast<float>(v));
+  if (h.type->kind == TypeKind::LReal) return st<double>(p, static_cast<double>(v));
+  switch (h.type->kind) {
+    case TypeKind::String: case TypeKind::WString: case TypeKind::Array: case TypeKind::Struct: case TypeKind::Pou:
+    case TypeKind::Void: return;
+    default: break;
+  }
+  switch (h.type->size) {
+    case 1: st<uint8_t>(p, static_cast<uint8_t>(h.type->kind == TypeKind::Bool ? v != 0 : v)); break;
+    case 2: st<uint16_t>(p, static_cast<uint16_t>(v)); break;
+    case 4: st<uint32_t>(p, static_cast<uint32_t>(v)); break;
+    case 8: st<uint64_t>(p, static_cast<uint64_t>(v)); break;
     default: break;
   }
 }

@@ -716,26 +716,24 @@ std::optional<Val> Compiler::temporal(const std::string& name, const CallExpr& c
   Slot cur = hidden(t->size, t->align), prev = hidden(t->size, t->align);
   if (!b_->started) b_->started = hidden(1, 1);
   Slot src = to_slot(v, t, args[0]->loc);
-  emit(mov_op(t->size), {cur, src});
+  if (!retarget(src, cur)) emit(mov_op(t->size), {cur, src});
   b_->edges.push_back({cur, prev, t->size});
   auto tmp_bool = [&]() { return temp(1, 1); };
-  Slot r = tmp_bool();
   if (edge) {
-    // RISING: not prev and cur; FALLING: prev and not cur; HIGH: prev and cur; LOW: neither.
-    Slot a = cur, b = prev;
-    if (name == "RISING" || name == "LOW") {
-      b = tmp_bool();
-      emit(Op::BNOT, {b, prev});
-    }
-    if (name == "FALLING" || name == "LOW") {
-      a = tmp_bool();
-      emit(Op::BNOT, {a, cur});
-    }
-    emit(Op::BAND, {r, a, b});
-  } else {
-    Op cmp = name == "CHANGES" ? Op::NE_I8 : name == "INCREASES" ? Op::GT_I8 : Op::LT_I8;
-    emit(num_op(cmp, t->storage()), {r, cur, prev});
+    // One instruction: RISING = cur AND NOT prev, FALLING, HIGH, LOW; FALSE before the
+    // first committed state.
+    Op op = name == "RISING" ? Op::RISE : name == "FALLING" ? Op::FALL : name == "HIGH" ? Op::STEADY_HIGH : Op::STEADY_LOW;
+    Slot out = tmp_bool();
+    emit(op, {out, cur, prev, *b_->started});
+    def(out);
+    Val res;
+    res.type = BOOL;
+    res.slot = out;
+    return res;
   }
+  Slot r = tmp_bool();
+  Op cmp = name == "CHANGES" ? Op::NE_I8 : name == "INCREASES" ? Op::GT_I8 : Op::LT_I8;
+  emit(num_op(cmp, t->storage()), {r, cur, prev});
   Slot out = tmp_bool();
   emit(Op::BAND, {out, r, *b_->started});
   def(out);

@@ -302,6 +302,7 @@ void Compiler::compile_pou(PouInfo* p) {
   Slot seen;
   if (state_in) {
     seen = hidden(8, 8);
+    b_->state_seen = seen;
     emit(Op::JNE_I64, {Arg::target(shift.id), Slot{state_in->offset, SK::Var}, seen});
     bind(body_start);
   }
@@ -359,6 +360,14 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   uint32_t frame_size = align_up(temp_base + b.temp_max, 8);
   for (auto [idx, kind] : b.slot_fix) b.code[idx] += kind == SK::Const ? const_base : kind == SK::Hidden ? hidden_base : temp_base;
   p->frame_size = frame_size;
+  // Monitors: where the state shift works, so a caller can do it natively (StateShift).
+  if (p->late && p->kind == PouKind::Program && b.state_seen) {
+    auto at = [&](Slot sl) { return sl.off + (sl.kind == SK::Hidden ? hidden_base : 0); };
+    p->shift.present = true;
+    p->shift.seen = at(*b.state_seen);
+    p->shift.started = b.started ? static_cast<int32_t>(at(*b.started)) : -1;
+    for (const auto& e : b.edges) p->shift.moves.push_back({at(e.cur), at(e.prev), e.size});
+  }
 
   // The frame's initial image: header, variables' initial values, constants.
   std::vector<uint8_t> image(frame_size, 0);

@@ -133,6 +133,7 @@ struct Body {
   };
   std::vector<Edge> edges;
   std::optional<Slot> started;  // TRUE once a state has been committed
+  std::optional<Slot> state_seen;  // the last __state evaluated
 };
 
 class Compiler {

@@ -3,6 +3,7 @@
 // any number of Machines can run it.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -59,6 +60,16 @@ struct Symbol {
 };
 
 // Layout and code of one POU (FUNCTION, FUNCTION_BLOCK, PROGRAM, METHOD, INTERFACE).
+// A monitor PROGRAM's state shift (previous := current of each temporal operator, at the
+// first evaluation of a new __state): frame offsets, so a caller may do it natively
+// before the call and spare the VM the work. Same effect as the program's own shift.
+struct StateShift {
+  bool present = false;
+  uint32_t seen = 0;     // LINT: the last state evaluated (-1: none yet)
+  int32_t started = -1;  // BOOL: a state has been committed (-1: no temporal operator)
+  std::vector<std::array<uint32_t, 3>> moves;  // {current, previous, size}
+};
+
 struct PouInfo {
   PouKind kind = PouKind::Program;
   std::string name;
@@ -87,6 +98,7 @@ struct PouInfo {
   bool declared = false;    // signature and variable layout done
   bool compiled = false;
   bool late = false;        // compiled after the program instances (monitors)
+  StateShift shift;         // late PROGRAMs with __state
   bool is_stdlib = false;
   bool recursion_mark = false;
 

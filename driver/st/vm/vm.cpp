@@ -420,6 +420,10 @@ L_BAND: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) & R(uint8_t, 3))); NEXT
 L_BOR: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) | R(uint8_t, 3))); NEXT(3);
 L_BXOR: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) ^ R(uint8_t, 3))); NEXT(3);
 L_BNOT: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) ^ 1u)); NEXT(2);
+L_RISE: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) & (R(uint8_t, 3) ^ 1u) & R(uint8_t, 4))); NEXT(4);
+L_FALL: W(uint8_t, 1, static_cast<uint8_t>((R(uint8_t, 2) ^ 1u) & R(uint8_t, 3) & R(uint8_t, 4))); NEXT(4);
+L_STEADY_HIGH: W(uint8_t, 1, static_cast<uint8_t>(R(uint8_t, 2) & R(uint8_t, 3) & R(uint8_t, 4))); NEXT(4);
+L_STEADY_LOW: W(uint8_t, 1, static_cast<uint8_t>((R(uint8_t, 2) ^ 1u) & (R(uint8_t, 3) ^ 1u) & R(uint8_t, 4))); NEXT(4);
 L_TOBOOL8: W(uint8_t, 1, R(uint8_t, 2) != 0); NEXT(2);
 L_TOBOOL16: W(uint8_t, 1, R(uint16_t, 2) != 0); NEXT(2);
 L_TOBOOL32: W(uint8_t, 1, R(uint32_t, 2) != 0); NEXT(2);
