@@ -291,7 +291,6 @@ TEST(Compiler, ValidProgramHasNoDiagnostics) {
 // IEC 61131-3 (6.6.1.4.2): a non-formal call lists every input in order; leaving one out
 // is only possible in a formal call.
 TEST(Compiler, NonFormalCallWithTooFewArgumentsIsAnError) {
-  GTEST_SKIP() << "engine bug: Add2(1) (non-formal call missing input b) compiles without error";
   auto b = compile_one(
       "FUNCTION Add2 : INT\nVAR_INPUT a, b : INT; END_VAR\nAdd2 := a + b;\nEND_FUNCTION\n"
       "PROGRAM Main\nVAR i : INT; END_VAR\ni := Add2(1);\nEND_PROGRAM\n");

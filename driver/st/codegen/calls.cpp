@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include <fmt/format.h>
+
 #include "compiler_impl.hpp"
 
 namespace plcfi::st::detail {
@@ -265,9 +267,17 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
     Val v = expr_for(*a.value, p->type);
     assign(frame_place(frame.plus(p->offset), p->type), v, a.value->loc);
   }
-  for (size_t i = 0; i < params.size(); ++i)
-    if (!given[i] && params[i]->where == Where::InOut)
-      diags_.error("ST224", c.loc, "VAR_IN_OUT '" + params[i]->name + "' of " + f->name + " must be passed");
+  // A non-formal call lists every input in order (IEC 61131-3 6.6.1.4.2); only a formal
+  // call may leave inputs at their initial values.
+  bool any_named = std::any_of(c.args.begin(), c.args.end(), [](const CallArg& a) { return a.name.has_value(); });
+  if (!any_named && pos > 0 && pos < params.size())
+    diags_.error("ST210", c.loc,
+                 fmt::format("{} takes {} argument(s), {} given; a non-formal call lists every input (or name them: {}({} := ...))",
+                             f->name, params.size(), pos, f->name, params[pos]->name));
+  else
+    for (size_t i = 0; i < params.size(); ++i)
+      if (!given[i] && params[i]->where == Where::InOut)
+        diags_.error("ST224", c.loc, "VAR_IN_OUT '" + params[i]->name + "' of " + f->name + " must be passed");
   mark(c.loc);
   emit(Op::CALL, {frame, Arg::entry(f)});
   for (const auto& o : outs) {
