@@ -206,14 +206,25 @@ TEST(VmTrap, MachineRunsNormallyAfterAnIndexTrap) {
 
 // An index wider than DINT must be checked at its full width, not after truncation.
 TEST(VmTrap, LintIndexIsCheckedWithoutTruncation) {
-  GTEST_SKIP() << "engine bug: a LINT index is truncated to DINT before the bounds check; "
-                  "arr[4294967297] reads arr[1] instead of trapping";
   VmRun r("PROGRAM Main\nVAR arr : ARRAY [1..5] OF INT := [11, 12, 13, 14, 15]; i : LINT := 4294967297; x : INT; END_VAR\n"
         "x := arr[i];\nEND_PROGRAM\n");
   ASSERT_TRUE(r.ok());
   EXPECT_FALSE(r.scan());
   EXPECT_EQ(TrapKind::IndexOutOfRange, r.m->trap().kind);
+  EXPECT_NE(r.m->trap().message.find("index 4294967297 outside 1..5"), std::string::npos) << r.m->trap().message;
   EXPECT_EQ(0, r.get("Main.x"));
+  // In range, a wide index works as any other.
+  VmRun ok("PROGRAM Main\nVAR arr : ARRAY [1..5] OF INT := [11, 12, 13, 14, 15]; i : LINT := 3; x : INT; END_VAR\n"
+           "x := arr[i];\nEND_PROGRAM\n");
+  ASSERT_TRUE(ok.ok());
+  EXPECT_TRUE(ok.scan());
+  EXPECT_EQ(13, ok.get("Main.x"));
+  // UDINT 4294967295 is not -1, although its 32 bits read as DINT are.
+  VmRun u("PROGRAM Main\nVAR arr : ARRAY [-1..1] OF INT := [7, 8, 9]; i : UDINT := 4294967295; x : INT; END_VAR\n"
+          "x := arr[i];\nEND_PROGRAM\n");
+  ASSERT_TRUE(u.ok());
+  EXPECT_FALSE(u.scan());
+  EXPECT_EQ(TrapKind::IndexOutOfRange, u.m->trap().kind);
 }
 
 const char* kSubrange = R"(PROGRAM Main

@@ -438,6 +438,20 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
       diags_.error("ST208", e.indices[i]->loc, "an array index must be an integer, not " + tname(v.type));
       return bad_place;
     }
+    // Index arithmetic is 32-bit: a wider index (LINT, ULINT, UDINT, ...) is checked
+    // against the bounds in its own type first, so a value that only fits after
+    // truncation traps instead of reaching another element.
+    if (v.type->is_integer() || v.type->is_bitstring()) {
+      bool wide = v.type->size == 8 || (v.type->size == 4 && !v.type->is_signed());
+      if (wide) {
+        int64_t lo = t->dims[i].lo, hi = t->dims[i].hi;
+        if (!v.type->is_signed() && lo < 0) lo = 0;
+        Slot los = konst(v.type, ConstV{ConstV::K::Int, lo, 0, {}}, e.indices[i]->loc);
+        Slot his = konst(v.type, ConstV{ConstV::K::Int, hi < 0 && !v.type->is_signed() ? 0 : hi, 0, {}}, e.indices[i]->loc);
+        mark(e.indices[i]->loc);
+        emit(int_op(Op::CHK_I8, v.type->storage()), {v.slot, los, his, 1u});
+      }
+    }
     dyn.emplace_back(i, convert(v.slot, v.type, elem(TypeKind::DInt)));
   }
   if (dyn.empty()) {

@@ -487,6 +487,9 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
   L_ROR_##TN: W(C, 1, ror<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
   L_CHK_##TN: {                                                                          \
     C v = R(C, 1), lo = R(C, 2), hi = R(C, 3);                                           \
+    if ((v < lo || v > hi) && pc[4] == 1)                                                \
+      return fail(TrapKind::IndexOutOfRange, pc,                                         \
+                  fmt::format("index {} outside {}..{}", +v, +lo, +hi));                 \
     if (v < lo || v > hi)                                                                \
       return fail(TrapKind::RangeError, pc,                                              \
                   fmt::format("value {} outside subrange {}..{}", +v, +lo, +hi));        \
