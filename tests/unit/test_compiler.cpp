@@ -302,8 +302,6 @@ TEST(Compiler, NonFormalCallWithTooFewArgumentsIsAnError) {
 // Untyped literals are ANY_INT: a generic standard function of literals takes its type
 // from the context, as `a := 10 + 20` does.
 TEST(Compiler, GenericFunctionOfLiteralsAdaptsToTheTarget) {
-  GTEST_SKIP() << "engine bug: mx : INT; mx := MAX(10, 20); fails with ST203 'cannot convert DINT to INT' "
-                  "(also LIMIT, SEL, MUX with literal inputs)";
   auto b = compile_one("PROGRAM Main\nVAR mx, a : INT; k : INT := 1; END_VAR\n"
                        "mx := MAX(10, 20);\nmx := LIMIT(0, 5, 3);\nmx := SEL(TRUE, 1, 2);\nmx := MUX(k, 10, 20, 30);\n"
                        "a := 10 + 20;\nEND_PROGRAM\n");

@@ -768,8 +768,12 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
       }
     }
     if (!t) {
+      // Only untyped literals: the context's type when it can hold them (an integer
+      // target for integer literals, a real one for any), else DINT / LREAL.
       bool real = false;
       for (auto& v : vals) real = real || v.c.k == ConstV::K::Real;
+      const Type* want = call_expected_;
+      if (want && (want->is_real() || (!real && (want->is_integer() || want->is_bitstring())))) return want;
       t = real ? elem(TypeKind::LReal) : elem(TypeKind::DInt);
     }
     return t;

@@ -241,6 +241,7 @@ class Compiler {
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
   std::optional<Val> builtin(const std::string& name, const CallExpr& c);
+  const Type* call_expected_ = nullptr;  // the type the context expects of the call being compiled
   std::optional<Val> conversion(const std::string& name, const CallExpr& c);
   Val property_get(const Place& inst, PouInfo* getter, Slot this_ptr, SourceLoc loc);
   void property_set(PouInfo* setter, Slot this_ptr, const Val& v, SourceLoc loc);

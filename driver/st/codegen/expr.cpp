@@ -981,7 +981,15 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
       case ExprKind::Index:
       case ExprKind::Deref:
       case ExprKind::BitAccess: return load(place(e, false));
-      case ExprKind::Call: return call(static_cast<const CallExpr&>(e), false);
+      case ExprKind::Call: {
+        // Generic standard functions of untyped literals (MAX(10, 20)) take their type
+        // from the context, as 10 + 20 does; the hint lasts for this call only.
+        const Type* saved = call_expected_;
+        call_expected_ = expected;
+        Val v = call(static_cast<const CallExpr&>(e), false);
+        call_expected_ = saved;
+        return v;
+      }
       case ExprKind::Unary: return unary(static_cast<const UnaryExpr&>(e), expected);
       case ExprKind::Binary: return binary(static_cast<const BinaryExpr&>(e), expected);
       case ExprKind::This: {
