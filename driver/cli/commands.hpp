@@ -14,5 +14,6 @@ int cmd_sim(const std::vector<std::string>& args);
 int cmd_edtl(const std::vector<std::string>& args);
 int cmd_generate(const std::vector<std::string>& args);
 int cmd_campaign(const std::vector<std::string>& args);
+int cmd_plant_server(const std::vector<std::string>& args);
 
 }  // namespace plcfi::cli

@@ -31,6 +31,7 @@ const std::vector<Command>& commands() {
       {"edtl", "check EDTL requirements on a recorded trace (edtl check REQS TRACE)", plcfi::cli::cmd_edtl},
       {"generate", "generate the prioritized fault-injection test cases of a campaign (TSD + FMEA)", plcfi::cli::cmd_generate},
       {"campaign", "run a passive fault-injection campaign on the plant model", plcfi::cli::cmd_campaign},
+      {"plant-server", "serve a plant model in real time over Modbus TCP (bench rehearsal)", plcfi::cli::cmd_plant_server},
   };
   return k;
 }
