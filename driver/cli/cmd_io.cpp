@@ -1,16 +1,25 @@
 // plcfi plant-server: a plant model in real time behind a Modbus TCP server.
 #include <atomic>
 #include <csignal>
+#include <cstring>
 #include <iostream>
+
+#include <sched.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
 
 #include <boost/program_options.hpp>
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "engine.hpp"
 #include "plant_model/plant.hpp"
+#include "runtime/clock.hpp"
+#include "runtime/runtime.hpp"
 #include "runtime/schedule.hpp"
 
 #ifdef PLCFI_HAVE_MODBUS
+#include "io/modbus/modbus_backend.hpp"
 #include "io/modbus/plant_server.hpp"
 #endif
 
@@ -20,8 +29,108 @@ namespace plcfi::cli {
 
 namespace {
 std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop.store(true); }
+std::atomic<int> g_signal{0};
+void on_signal(int s) {
+  g_signal.store(s);
+  g_stop.store(true);
+}
+
+// Real-time set-up of the scan thread; each step that fails is reported and skipped (a
+// bench run without privileges still runs, with worse latency).
+void realtime_setup(const RealtimeOptions& o) {
+  prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
+  if (o.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    std::cerr << "plcfi run: warning: mlockall: " << std::strerror(errno) << " (page faults may add latency)\n";
+  if (o.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(o.cpu, &set);
+    if (sched_setaffinity(0, sizeof set, &set) != 0)
+      std::cerr << "plcfi run: warning: CPU affinity " << o.cpu << ": " << std::strerror(errno) << "\n";
+  }
+  if (o.priority > 0) {
+    sched_param sp{};
+    sp.sched_priority = o.priority;
+    if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
+      std::cerr << "plcfi run: warning: SCHED_FIFO priority " << o.priority << ": " << std::strerror(errno) << "\n";
+  }
+}
 }  // namespace
+
+int run_with_io(const st::Application& app, const rt::Schedule& sched, const std::string& io_path, const RunIoOptions& o,
+                const std::function<bool(st::Machine&)>& setup, const std::function<void(st::Machine&, int)>& report) {
+#ifndef PLCFI_HAVE_MODBUS
+  std::cerr << "plcfi run: --io needs a plcfi built with Modbus (PLCFI_MODBUS=ON)\n";
+  return 2;
+#else
+  std::string err;
+  io::IoConfig cfg;
+  if (!io::load_io_config(io_path, app, &cfg, &err)) {
+    std::cerr << err << "\n";
+    return 2;
+  }
+  auto backend = io::ModbusBackend::create(cfg, sched.tick_ns(), &err);
+  if (!backend) {
+    std::cerr << err << "\n";
+    return 2;
+  }
+  rt::Runtime runtime(app, sched, backend.get());
+  runtime.set_safe_state(cfg.safe_state);
+  runtime.cold_restart(1);
+  if (!setup(runtime.machine())) return 2;
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGPIPE, SIG_IGN);
+  if (o.realtime) realtime_setup(o.rt);
+  rt::RealTimePacer pacer(sched.tick_ns());
+  pacer.start();
+  uint64_t scans = 0;
+  int status = 0;
+  std::string why = "done";
+  const int64_t t0 = rt::RealTimePacer::monotonic_ns();
+  while (true) {
+    if (g_stop.load()) {
+      why = g_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT";
+      break;
+    }
+    if (o.cycles && scans >= o.cycles) break;
+    if (o.duration_ns && rt::RealTimePacer::monotonic_ns() - t0 >= o.duration_ns) break;
+    if (o.realtime) pacer.wait_next();
+    int64_t a = rt::RealTimePacer::monotonic_ns();
+    rt::ScanStatus st = runtime.scan();
+    pacer.record_exec(rt::RealTimePacer::monotonic_ns() - a);
+    ++scans;
+    if (st == rt::ScanStatus::Trapped) {
+      why = "trap: " + runtime.stop_reason();
+      status = 1;
+      break;
+    }
+    size_t lost = backend->lost_device(runtime.now());
+    if (lost != SIZE_MAX) {
+      why = "communication lost: " + backend->stats()[lost].last_error;
+      status = 1;
+      break;
+    }
+  }
+  // Every way out: the safe output state reaches the devices before they are closed.
+  runtime.write_safe_outputs();
+  backend->close();
+  std::cout << fmt::format("plcfi run: {} scans of {} ms over {}, ended: {}; outputs written to the safe state{}\n", scans,
+                           static_cast<double>(sched.tick_ns()) / 1e6, cfg.path, why,
+                           cfg.safe_state.empty() ? " (all off)" : fmt::format(" (all off but {})", cfg.safe_state.size()));
+  if (o.realtime)
+    std::cout << fmt::format("  wake latency   {}\n  execution      {}\n  overruns       {}\n", pacer.wake_latency().summary(),
+                             pacer.exec_time().summary(), pacer.overruns());
+  for (size_t i = 0; i < cfg.devices.size(); ++i) {
+    const auto& d = backend->stats()[i];
+    std::cout << fmt::format("  device {}: {} requests, {} failed, {} connect(s), {} disconnect(s){}\n", cfg.devices[i].name,
+                             d.requests, d.failures, d.connects, d.disconnects,
+                             d.last_error.empty() ? "" : "; last error: " + d.last_error);
+  }
+  report(runtime.machine(), status);
+  return status;
+#endif
+}
 
 int cmd_plant_server(const std::vector<std::string>& args) {
   po::options_description desc("plcfi plant-server: a plant model in real time behind a Modbus TCP server");

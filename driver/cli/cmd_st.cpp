@@ -106,9 +106,14 @@ int cmd_run(const std::vector<std::string>& args) {
       ("print", po::value<std::vector<std::string>>(), "PATH to print at the end (repeatable)")
       ("json", "print the result as JSON")
       ("coverage", "print branch coverage per file")
-      ("budget", po::value<uint64_t>()->default_value(10'000'000), "loop iterations allowed per program call (watchdog)");
+      ("budget", po::value<uint64_t>()->default_value(10'000'000), "loop iterations allowed per program call (watchdog)")
+      ("io", po::value<std::string>(), "exchange the image with real I/O (a file with an io: section: Modbus devices and mappings)")
+      ("realtime", "with --io: pace the scans on absolute real-time deadlines, report wake latency")
+      ("duration", po::value<std::string>(), "with --io: run this long (e.g. 10s); SIGINT/SIGTERM also end the run")
+      ("rt-priority", po::value<int>()->default_value(0), "with --realtime: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
+      ("cpu", po::value<int>()->default_value(-1), "with --realtime: pin the scan thread to this CPU");
   po::variables_map vm;
-  if (!parse(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json]")) return 0;
+  if (!parse(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE [--realtime] [--duration T]]")) return 0;
   st::CompileOptions opt;
   opt.warnings = false;
   auto b = load(files_of(vm), opt, "run");
@@ -131,6 +136,47 @@ int cmd_run(const std::vector<std::string>& args) {
   if (!ok_sched) {
     std::cerr << "plcfi run: " << err << "\n";
     return 2;
+  }
+  if (vm.count("io")) {
+    RunIoOptions o;
+    o.realtime = vm.count("realtime") > 0;
+    o.rt.priority = vm["rt-priority"].as<int>();
+    o.rt.cpu = vm["cpu"].as<int>();
+    if (o.rt.priority < 0 || o.rt.priority > 99) {
+      std::cerr << "plcfi run: --rt-priority must be 0..99\n";
+      return 2;
+    }
+    if (vm.count("duration") && (!rt::parse_duration(vm["duration"].as<std::string>(), &o.duration_ns, &err) || o.duration_ns <= 0)) {
+      std::cerr << "plcfi run: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
+      return 2;
+    }
+    if (!vm["cycles"].defaulted() || !vm.count("duration")) o.cycles = vm["cycles"].as<uint64_t>();
+    std::vector<std::string> sets = vm.count("set") ? vm["set"].as<std::vector<std::string>>() : std::vector<std::string>{};
+    std::vector<std::string> prints = vm.count("print") ? vm["print"].as<std::vector<std::string>>() : std::vector<std::string>{};
+    auto setup = [&](st::Machine& mm) {
+      mm.set_budget(vm["budget"].as<uint64_t>());
+      for (const auto& sv : sets) {
+        auto eq = sv.find('=');
+        auto h = eq == std::string::npos ? std::nullopt : st::resolve(app, sv.substr(0, eq), &err);
+        if (!h || !st::write_text(mm, *h, sv.substr(eq + 1), &err)) {
+          std::cerr << "plcfi run: --set '" << sv << "': " << (eq == std::string::npos ? "expected PATH=VALUE" : err) << "\n";
+          return false;
+        }
+      }
+      for (const auto& p : prints)
+        if (!st::resolve(app, p, &err)) {
+          std::cerr << "plcfi run: --print: " << err << "\n";
+          return false;
+        }
+      return true;
+    };
+    auto report = [&](st::Machine& mm, int) {
+      for (const auto& p : prints) {
+        auto h = st::resolve(app, p, &err);
+        std::cout << h->path << " = " << st::format(mm, *h) << "\n";
+      }
+    };
+    return run_with_io(app, sched, vm["io"].as<std::string>(), o, setup, report);
   }
   st::Machine m(app);
   m.set_budget(vm["budget"].as<uint64_t>());

@@ -1,8 +1,14 @@
 // The plcfi subcommands. Each takes the arguments after its name and returns the exit status.
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
+
+#include "runtime/schedule.hpp"
+#include "vm/program.hpp"
+#include "vm/vm.hpp"
 
 namespace plcfi::cli {
 
@@ -15,5 +21,21 @@ int cmd_edtl(const std::vector<std::string>& args);
 int cmd_generate(const std::vector<std::string>& args);
 int cmd_campaign(const std::vector<std::string>& args);
 int cmd_plant_server(const std::vector<std::string>& args);
+
+// `plcfi run --io`: the program on real I/O (Modbus), optionally paced in real time.
+struct RealtimeOptions {
+  int priority = 0;  // SCHED_FIFO priority (0: keep the normal scheduler)
+  int cpu = -1;      // CPU affinity (-1: any)
+  bool lock_memory = true;
+};
+struct RunIoOptions {
+  uint64_t cycles = 0;      // 0: no limit
+  int64_t duration_ns = 0;  // 0: no limit
+  bool realtime = false;
+  RealtimeOptions rt;
+};
+// setup() runs once after the cold restart (--set); report() at the end (--print).
+int run_with_io(const st::Application& app, const rt::Schedule& sched, const std::string& io_path, const RunIoOptions& o,
+                const std::function<bool(st::Machine&)>& setup, const std::function<void(st::Machine&, int)>& report);
 
 }  // namespace plcfi::cli

@@ -216,13 +216,26 @@ bool load_io_config(const std::string& path, const st::Application& app, IoConfi
   Reader r(path, app);
   try {
     YAML::Node io = root.IsMap() && root["io"] ? root["io"] : root;
-    r.keys(io, {"devices", "map"}, "the io section");
+    r.keys(io, {"devices", "map", "safe_state"}, "the io section");
     const YAML::Node devs = io["devices"];
     if (!devs || !devs.IsSequence() || devs.size() == 0) r.fail(io, "io needs a list of devices");
     for (const auto& d : devs) r.device(d, out);
     const YAML::Node map = io["map"];
     if (!map || !map.IsSequence() || map.size() == 0) r.fail(io, "io needs a map: list of image ranges");
     for (const auto& p : map) r.point(p, out);
+    if (const YAML::Node safe = io["safe_state"]) {
+      if (!safe.IsMap()) r.fail(safe, "safe_state maps outputs to values, e.g. {\"%QX0.0\": TRUE}");
+      for (const auto& kv : safe) {
+        rt::ImageRef ref = r.image(kv.first, "safe_state");
+        if (ref.area != 'Q') r.fail(kv.first, "safe_state lists outputs (%Q)");
+        std::string v = r.str(kv.second, "a safe value");
+        int64_t x = 0;
+        if (v == "TRUE" || v == "true") x = 1;
+        else if (v == "FALSE" || v == "false") x = 0;
+        else x = r.integer(kv.second, "a safe value", ref.is_bit ? 0 : -32768, ref.is_bit ? 1 : 65535);
+        out->safe_state.emplace_back(ref, x);
+      }
+    }
   } catch (const Fail& f) {
     *err = f.message;
     return false;

@@ -49,6 +49,8 @@ struct IoConfig {
   std::string path;
   std::vector<ModbusDevice> devices;
   std::vector<ModbusPoint> points;
+  // Outputs whose safe value is not 0 (written on every way out; all others go to 0).
+  std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
   bool empty() const { return devices.empty(); }
 };
 

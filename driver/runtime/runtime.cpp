@@ -48,9 +48,14 @@ void Runtime::reapply_input_overlay() {
   in_overlay_.apply(machine_.mem() + app_->image_i.addr, raw_in_.data(), in_extent(), now_ns_);
 }
 
+void Runtime::fill_safe(uint8_t* q) {
+  std::memset(q, 0, app_->image_q.size);
+  for (const auto& [ref, v] : safe_values_) ref.set(q, v);
+}
+
 void Runtime::write_safe_outputs() {
-  std::fill(out_.begin(), out_.end(), 0);
-  std::memset(machine_.mem() + app_->image_q.addr, 0, app_->image_q.size);
+  fill_safe(machine_.mem() + app_->image_q.addr);
+  std::memcpy(out_.data(), machine_.mem() + app_->image_q.addr, out_.size());
   if (backend_) backend_->write(out_.data(), now_ns_, 0);
 }
 
@@ -104,7 +109,7 @@ ScanStatus Runtime::scan() {
   }
   machine_.merge_coverage();
   for (ScanHooks* h : hooks_) h->after_scan(*this);
-  if (stopped_) std::memset(mem + app_->image_q.addr, 0, app_->image_q.size);  // safe state
+  if (stopped_) fill_safe(mem + app_->image_q.addr);  // safe state
   out_overlay_.apply(out_.data(), mem + app_->image_q.addr, out_extent(), now_ns_);
   if (backend_ && !backend_->write(out_.data(), now_ns_, tick) && status == ScanStatus::Ok) status = ScanStatus::IoError;
   for (ScanHooks* h : hooks_) h->end_of_scan(*this);

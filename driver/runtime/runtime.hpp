@@ -76,8 +76,12 @@ class Runtime {
   // first call. A trap in the probe is forgotten: the real scan will meet it again.
   const std::vector<uint64_t>& probe_branches();
 
-  // All outputs to the safe state (zero: valves off, setpoints 0) and sent to the backend.
+  // All outputs to the safe state (zero: valves off, setpoints 0, except the configured
+  // exceptions) and sent to the backend.
   void write_safe_outputs();
+  // Outputs whose safe value is not 0 (a brake released by TRUE, a slider kept out
+  // under a lowered stamp). Applied after zeroing, in order.
+  void set_safe_state(std::vector<std::pair<ImageRef, int64_t>> values) { safe_values_ = std::move(values); }
   // Stops the program (e.g. a watchdog of the caller); outputs go to the safe state.
   void stop(const std::string& reason);
 
@@ -96,6 +100,8 @@ class Runtime {
   Overlay in_overlay_, out_overlay_;
   std::vector<uint8_t> raw_in_, out_;
   std::vector<uint8_t> probe_mem_;
+  std::vector<std::pair<ImageRef, int64_t>> safe_values_;
+  void fill_safe(uint8_t* q);
   std::vector<uint64_t> probe_taken_;
   int64_t now_ns_ = 0;
   uint64_t scans_ = 0;

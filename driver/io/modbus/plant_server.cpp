@@ -115,10 +115,17 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
   const auto start = clock::now();
   auto next = start + std::chrono::nanoseconds(opt.tick_ns);
   const double dt = static_cast<double>(opt.tick_ns) * 1e-9;
+  // The plant's clock starts with the first client: a PLC that connects later does not
+  // miss what the operator does at the start (the start button press, for instance).
+  bool running = false;
   while (!stop.load()) {
     auto now = clock::now();
     if (opt.duration_ns > 0 && now - start >= std::chrono::nanoseconds(opt.duration_ns)) break;
-    if (now >= next) {
+    if (!running && !clients.empty()) {
+      running = true;
+      next = now + std::chrono::nanoseconds(opt.tick_ns);
+    }
+    if (running && now >= next) {
       // Step on absolute deadlines; a late step is counted, not made up for in a burst.
       if (now - next > std::chrono::nanoseconds(opt.tick_ns)) {
         ++stats->late_steps;
@@ -143,7 +150,7 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
       FD_SET(fd, &rd);
       maxfd = std::max(maxfd, fd);
     }
-    auto wait = std::chrono::duration_cast<std::chrono::microseconds>(next - now);
+    auto wait = running ? std::chrono::duration_cast<std::chrono::microseconds>(next - now) : std::chrono::microseconds(20'000);
     timeval tv{static_cast<time_t>(wait.count() / 1'000'000), static_cast<suseconds_t>(wait.count() % 1'000'000)};
     int r = select(maxfd + 1, &rd, nullptr, nullptr, &tv);
     if (r < 0) {

@@ -2,7 +2,7 @@
 // run be rehearsed end to end over a real protocol stack. The register map follows the
 // plant's default image addresses: a sensor on %IXb.i is discrete input 8*b+i, one on
 // %IWn input register n; an actuator on %QXb.i is coil 8*b+i, one on %QWn holding
-// register n. Any unit id is answered.
+// register n. Any unit id is answered. The plant's time starts with the first client.
 #pragma once
 
 #include <atomic>
