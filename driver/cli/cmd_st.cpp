@@ -108,8 +108,8 @@ int cmd_run(const std::vector<std::string>& args) {
       ("coverage", "print branch coverage per file")
       ("budget", po::value<uint64_t>()->default_value(10'000'000), "loop iterations allowed per program call (watchdog)")
       ("io", po::value<std::string>(), "exchange the image with real I/O (a file with an io: section: Modbus devices and mappings)")
-      ("realtime", "with --io: pace the scans on absolute real-time deadlines, report wake latency")
-      ("duration", po::value<std::string>(), "with --io: run this long (e.g. 10s); SIGINT/SIGTERM also end the run")
+      ("realtime", "pace the scans on absolute real-time deadlines and report wake latency (with or without --io)")
+      ("duration", po::value<std::string>(), "with --io or --realtime: run this long (e.g. 10s); SIGINT/SIGTERM also end the run")
       ("rt-priority", po::value<int>()->default_value(0), "with --realtime: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
       ("cpu", po::value<int>()->default_value(-1), "with --realtime: pin the scan thread to this CPU");
   po::variables_map vm;
@@ -137,7 +137,7 @@ int cmd_run(const std::vector<std::string>& args) {
     std::cerr << "plcfi run: " << err << "\n";
     return 2;
   }
-  if (vm.count("io")) {
+  if (vm.count("io") || vm.count("realtime")) {
     RunIoOptions o;
     o.realtime = vm.count("realtime") > 0;
     o.rt.priority = vm["rt-priority"].as<int>();
@@ -176,7 +176,7 @@ int cmd_run(const std::vector<std::string>& args) {
         std::cout << h->path << " = " << st::format(mm, *h) << "\n";
       }
     };
-    return run_with_io(app, sched, vm["io"].as<std::string>(), o, setup, report);
+    return run_with_io(app, sched, vm.count("io") ? vm["io"].as<std::string>() : "", o, setup, report);
   }
   st::Machine m(app);
   m.set_budget(vm["budget"].as<uint64_t>());
