@@ -17,6 +17,7 @@
 #include "journal.hpp"
 #include "plant_model/plant.hpp"
 #include "report/trace.hpp"
+#include "runtime/clock.hpp"
 #include "runtime/runtime.hpp"
 
 namespace plcfi::campaign {
@@ -327,6 +328,9 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
   const Campaign& c = cb.spec;
   const st::Application& app = *cb.build->app;
   rt::Runtime runtime(app, cb.schedule, backend);
+  runtime.set_safe_state(opt.safe_state);
+  rt::RealTimePacer pacer(cb.schedule.tick_ns());
+  if (opt.realtime) pacer.start();
   PassiveDriver driver(cb, opt);
   runtime.add_hooks(&driver);
 
@@ -373,6 +377,20 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
     driver.begin_run(pr.run);
     bool search_over = false;
     while (!driver.done()) {
+      if (opt.stop && opt.stop()) {
+        out->end_reason = "interrupted by a signal";
+        out->interrupted = true;
+        break;
+      }
+      if (opt.io_lost) {
+        std::string lost = opt.io_lost();
+        if (!lost.empty()) {
+          out->end_reason = "communication lost: " + lost;
+          out->interrupted = true;
+          break;
+        }
+      }
+      if (opt.realtime) pacer.wait_next();
       runtime.scan();
       ++pr.scans;
       pr.campaign_ns += tick;
@@ -389,6 +407,13 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
         pr.cases_tested = driver.cases_tested();
         opt.on_progress(pr);
       }
+    }
+    if (out->interrupted) {
+      // Every way out of a run on real I/O: the fault withdrawn, the safe state written.
+      runtime.input_overlay().clear();
+      runtime.output_overlay().clear();
+      runtime.write_safe_outputs();
+      break;
     }
     if (!driver.error().empty()) {
       *err = "internal error: " + driver.error();
@@ -413,6 +438,9 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
       break;
     }
   }
+  runtime.input_overlay().clear();
+  runtime.output_overlay().clear();
+  runtime.write_safe_outputs();
   runtime.remove_hooks(&driver);
   std::vector<bool> seen(cb.cases.size(), false);
   for (const auto& e : out->executions) seen[e.case_index] = true;

@@ -51,6 +51,12 @@ struct DriverOptions {
   bool vcd = true;
   std::function<void(const Execution&, const Progress&)> on_verdict;
   std::function<void(const Progress&)> on_progress;  // about every simulated second
+  // Real I/O: scans paced on real-time deadlines; the run ends (faults withdrawn, safe
+  // outputs written) when stop() says so or io_lost() names a lost device.
+  bool realtime = false;
+  std::function<bool()> stop;
+  std::function<std::string()> io_lost;
+  std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
 };
 
 struct CampaignResult {
@@ -59,6 +65,7 @@ struct CampaignResult {
   Progress progress;
   size_t resumed = 0;                 // executions read back from the journal
   std::string end_reason;             // "all cases tested", "search window ...", "budget ..."
+  bool interrupted = false;           // stopped by a signal or lost communication (incomplete)
   double wall_s = 0;
 };
 

@@ -528,7 +528,7 @@ std::string relative_to(const std::string& base_file, const std::string& p) {
 void parse_campaign(const YamlFile& f, Campaign* c) {
   f.keys(f.root,
          {"campaign", "text", "program", "plant", "plant_config", "cycle", "tsd", "fmea", "fault_classes", "seed", "budget",
-          "max_paths", "search_window", "restart"},
+          "max_paths", "search_window", "restart", "io"},
          "a campaign file");
   c->path = f.path;
   c->name = f.scalar(f.required(f.root, "campaign", "the campaign file"), "campaign");
@@ -571,6 +571,7 @@ void parse_campaign(const YamlFile& f, Campaign* c) {
     else if (r == "warm") c->restart = RestartKind::Warm;
     else f.fail(f.root["restart"], "restart must be 'cold' or 'warm'");
   }
+  if (f.root["io"]) c->io = relative_to(f.path, f.scalar(f.root["io"], "io"));
   std::string tsd = relative_to(f.path, f.scalar(f.required(f.root, "tsd", "the campaign file"), "tsd"));
   std::string fmea = relative_to(f.path, f.scalar(f.required(f.root, "fmea", "the campaign file"), "fmea"));
   std::string classes =

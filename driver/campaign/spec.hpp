@@ -126,6 +126,7 @@ struct Campaign {
   int max_paths = 3;
   int64_t search_window_ns = 60'000'000'000;
   RestartKind restart = RestartKind::Cold;
+  std::string io;  // a file with an io: section: the campaign runs on real I/O (needs --arm)
   Tsd tsd;
   Fmea fmea;
   FaultClasses classes;

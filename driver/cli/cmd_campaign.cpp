@@ -18,11 +18,20 @@
 #include "report/junit.hpp"
 #include "report/puml.hpp"
 
+#ifdef PLCFI_HAVE_MODBUS
+#include "io/modbus/modbus_backend.hpp"
+#endif
+#include <atomic>
+#include <csignal>
+
 namespace po = boost::program_options;
 
 namespace plcfi::cli {
 
 namespace {
+
+std::atomic<bool> g_campaign_stop{false};
+void on_campaign_signal(int) { g_campaign_stop.store(true); }
 
 using campaign::CampaignBuild;
 using campaign::TestCase;
@@ -210,7 +219,9 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
       ("seed", po::value<uint64_t>(), "seed instead of the campaign's")
       ("no-vcd", "no VCD trace per test")
-      ("quiet", "no live progress line");
+      ("quiet", "no live progress line")
+      ("io", po::value<std::string>(), "run on real I/O: a file with an io: section (instead of the campaign's io: or plant)")
+      ("arm", "allow fault injection on real I/O (required with io:)");
   po::variables_map vm;
   if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
   CampaignBuild cb;
@@ -252,7 +263,49 @@ int cmd_campaign(const std::vector<std::string>& args) {
     progress_line(p);
   };
   campaign::CampaignResult res;
-  if (!campaign::run_campaign(cb, opt, &res, &err)) {
+  std::string io_path = vm.count("io") ? vm["io"].as<std::string>() : c.io;
+  bool ran = false;
+  if (!io_path.empty()) {
+    if (!vm.count("arm")) {
+      std::cerr << "plcfi campaign: refusing to inject faults on real I/O (" << io_path
+                << ") without --arm: the campaign forces sensor values and suppresses or changes actuator commands on the "
+                   "machine. Make sure the bench is safe to run and that stopping it is possible, then add --arm.\n";
+      return 2;
+    }
+#ifndef PLCFI_HAVE_MODBUS
+    std::cerr << "plcfi campaign: this plcfi was built without Modbus (PLCFI_MODBUS=OFF)\n";
+    return 2;
+#else
+    io::IoConfig io_cfg;
+    if (!io::load_io_config(io_path, *cb.build->app, &io_cfg, &err)) {
+      std::cerr << err << "\n";
+      return 2;
+    }
+    auto backend = io::ModbusBackend::create(io_cfg, cb.schedule.tick_ns(), &err);
+    if (!backend) {
+      std::cerr << err << "\n";
+      return 2;
+    }
+    std::signal(SIGINT, on_campaign_signal);
+    std::signal(SIGTERM, on_campaign_signal);
+    std::signal(SIGPIPE, SIG_IGN);
+    opt.realtime = true;
+    opt.stop = [] { return g_campaign_stop.load(); };
+    auto* mb = backend.get();
+    opt.io_lost = [mb]() -> std::string {
+      size_t d = mb->lost_device();
+      return d == SIZE_MAX ? "" : mb->stats()[d].last_error;
+    };
+    opt.safe_state = io_cfg.safe_state;
+    std::cout << fmt::format("  armed: real I/O over {} in real time; SIGINT/SIGTERM withdraw the fault and write the safe state\n",
+                             io_path);
+    ran = campaign::run_campaign_on(cb, backend.get(), opt, &res, &err);
+    backend->close();
+#endif
+  } else {
+    ran = campaign::run_campaign(cb, opt, &res, &err);
+  }
+  if (!ran) {
     if (live) std::cerr << "\n";
     std::cerr << "plcfi campaign: " << err << "\n";
     return 2;
@@ -336,6 +389,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
       std::cerr << "plcfi campaign: " << err << "\n";
       return 2;
     }
+  }
+  if (res.interrupted) {
+    std::cout << "campaign incomplete (" << res.end_reason << "); finish it with --resume\n";
+    return 1;
   }
   return fail || !res.not_reached.empty() ? 1 : 0;
 }

@@ -121,7 +121,7 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
       status = 1;
       break;
     }
-    size_t lost = backend ? backend->lost_device(runtime.now()) : SIZE_MAX;
+    size_t lost = backend ? backend->lost_device() : SIZE_MAX;
     if (lost != SIZE_MAX) {
       why = "communication lost: " + backend->stats()[lost].last_error;
       status = 1;

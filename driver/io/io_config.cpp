@@ -75,7 +75,7 @@ class Reader {
   }
 
   void device(const YAML::Node& n, IoConfig* cfg) const {
-    keys(n, {"name", "tcp", "rtu", "unit", "timeout", "status", "reconnect", "lost_after"}, "a device");
+    keys(n, {"name", "tcp", "rtu", "unit", "timeout", "status", "reconnect", "lost_after", "reset_register"}, "a device");
     ModbusDevice d;
     d.where = at(n);
     if (!n["name"]) fail(n, "a device needs a name");
@@ -139,6 +139,7 @@ class Reader {
       if (d.reconnect_max_ns < d.reconnect_min_ns) fail(rc, "reconnect max is below min");
     }
     if (n["lost_after"]) d.lost_after_ns = duration(n["lost_after"], "lost_after");
+    if (n["reset_register"]) d.reset_register = static_cast<int>(integer(n["reset_register"], "reset_register", 0, 65535));
     cfg->devices.push_back(d);
   }
 

@@ -31,6 +31,7 @@ struct ModbusDevice {
   bool has_status = false;
   rt::ImageRef status;             // %IX bit: TRUE while the device answers
   int64_t lost_after_ns = 0;       // communication lost this long: the run stops in the safe state (0: never)
+  int reset_register = -1;         // holding register written with 1 to restart the plant (a campaign's restart), -1: none
   std::string where;               // FILE:LINE:COL of its entry
 };
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 
 #include <fmt/format.h>
 #include <modbus/modbus.h>
@@ -10,6 +11,12 @@
 namespace plcfi::io {
 
 namespace {
+
+// Reconnect timing and lost_after run on the monotonic clock: the scan clock restarts at
+// zero with every cold restart of a campaign, the devices' connections do not.
+int64_t mono() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 bool is_bits(ModbusTable t) { return t == ModbusTable::Coils || t == ModbusTable::DiscreteInputs; }
 
@@ -128,7 +135,8 @@ bool ModbusBackend::ensure(size_t i, int64_t now) {
   return true;
 }
 
-size_t ModbusBackend::lost_device(int64_t now) const {
+size_t ModbusBackend::lost_device() const {
+  const int64_t now = mono();
   for (size_t i = 0; i < dev_.size(); ++i) {
     const auto& c = cfg_.devices[i];
     if (c.lost_after_ns > 0 && dev_[i].down_since >= 0 && now - dev_[i].down_since >= c.lost_after_ns) return i;
@@ -136,7 +144,21 @@ size_t ModbusBackend::lost_device(int64_t now) const {
   return SIZE_MAX;
 }
 
-bool ModbusBackend::read(uint8_t* inputs, int64_t now) {
+void ModbusBackend::reset(uint64_t) {
+  const int64_t now = mono();
+  for (size_t i = 0; i < dev_.size(); ++i) {
+    int reg = cfg_.devices[i].reset_register;
+    if (reg < 0 || !ensure(i, now)) continue;
+    ++stats_[i].requests;
+    if (modbus_write_register(dev_[i].ctx, reg, 1) != 1) {
+      ++stats_[i].failures;
+      drop(i, now, fmt::format("reset (holding register {}): {}", reg, modbus_strerror(errno)));
+    }
+  }
+}
+
+bool ModbusBackend::read(uint8_t* inputs, int64_t) {
+  const int64_t now = mono();
   bool ok = true;
   for (size_t i = 0; i < dev_.size(); ++i)
     if (!ensure(i, now)) ok = false;
@@ -179,7 +201,8 @@ bool ModbusBackend::read(uint8_t* inputs, int64_t now) {
   return ok;
 }
 
-bool ModbusBackend::write(const uint8_t* outputs, int64_t now, int64_t) {
+bool ModbusBackend::write(const uint8_t* outputs, int64_t, int64_t) {
+  const int64_t now = mono();
   bool ok = true;
   for (const Block& b : blocks_) {
     if (!b.output || !dev_[b.device].connected) {

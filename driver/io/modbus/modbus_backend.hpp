@@ -38,12 +38,15 @@ class ModbusBackend final : public rt::IoBackend {
   // (one per block) plus one connect attempt per device that is due for it.
   bool read(uint8_t* inputs, int64_t now_ns) override;
   bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) override;
-  void reset(uint64_t seed) override {}
+  // A restart: devices with a reset_register get 1 written there (a plant that can be
+  // re-initialized remotely, as plcfi plant-server); others are left as they are.
+  void reset(uint64_t seed) override;
   const std::string& last_error() const override { return error_; }
 
   const std::vector<DeviceStats>& stats() const { return stats_; }
-  // The device that has been down longer than its lost_after (SIZE_MAX: none).
-  size_t lost_device(int64_t now_ns) const;
+  // The device that has been down longer than its lost_after, on the monotonic clock
+  // (SIZE_MAX: none).
+  size_t lost_device() const;
   const IoConfig& config() const { return cfg_; }
   // Closes every connection (the driver writes the safe state before).
   void close();

@@ -67,7 +67,7 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
                  std::string* err, void (*on_listening)(const PlantServerOptions&)) {
   const auto& sig = plant.signals();
   std::vector<Binding> bind;
-  int n_bits = 16, n_in_bits = 16, n_regs = 8, n_in_regs = 8;
+  int n_bits = 16, n_in_bits = 16, n_regs = kResetRegister + 1, n_in_regs = 8;
   for (size_t i = 0; i < sig.size(); ++i) {
     Binding b{i, false, false, 0, sig[i].kind};
     if (!plant_address(sig[i].address, &b.input, &b.bit, &b.index)) {
@@ -130,6 +130,13 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
       if (now - next > std::chrono::nanoseconds(opt.tick_ns)) {
         ++stats->late_steps;
         next = now;
+      }
+      if (c.map->tab_registers[kResetRegister] != 0) {
+        // A test system asks for a new start: the plant back to its initial state.
+        c.map->tab_registers[kResetRegister] = 0;
+        plant.reset(opt.seed + ++stats->resets);
+        plant.sense(sen.data());
+        publish();
       }
       for (const auto& b : bind) {
         if (b.input) continue;

@@ -3,6 +3,7 @@
 // plant's default image addresses: a sensor on %IXb.i is discrete input 8*b+i, one on
 // %IWn input register n; an actuator on %QXb.i is coil 8*b+i, one on %QWn holding
 // register n. Any unit id is answered. The plant's time starts with the first client.
+// Writing a non-zero value to holding register 100 resets the plant (a campaign's restart).
 #pragma once
 
 #include <atomic>
@@ -14,6 +15,8 @@
 
 namespace plcfi::io {
 
+constexpr int kResetRegister = 100;
+
 struct PlantServerOptions {
   std::string host = "127.0.0.1";  // loopback unless asked otherwise
   std::string port = "1502";
@@ -23,7 +26,7 @@ struct PlantServerOptions {
 };
 
 struct PlantServerStats {
-  uint64_t steps = 0, requests = 0, connections = 0;
+  uint64_t steps = 0, requests = 0, connections = 0, resets = 0;
   int64_t late_steps = 0;  // ticks that started after their deadline (overloaded machine)
 };
 
