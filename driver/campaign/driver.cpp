@@ -329,6 +329,16 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
   const st::Application& app = *cb.build->app;
   rt::Runtime runtime(app, cb.schedule, backend);
   runtime.set_safe_state(opt.safe_state);
+  // Every way out of this function, errors included: the fault withdrawn (both overlays
+  // cleared) and the safe output state written to the backend.
+  struct SafeExit {
+    rt::Runtime& r;
+    ~SafeExit() {
+      r.input_overlay().clear();
+      r.output_overlay().clear();
+      r.write_safe_outputs();
+    }
+  } safe_exit{runtime};
   rt::RealTimePacer pacer(cb.schedule.tick_ns());
   if (opt.realtime) pacer.start();
   PassiveDriver driver(cb, opt);
@@ -390,8 +400,13 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
           break;
         }
       }
-      if (opt.realtime) pacer.wait_next();
+      int64_t woke = 0;
+      if (opt.realtime) {
+        pacer.wait_next();
+        woke = rt::RealTimePacer::monotonic_ns();
+      }
       runtime.scan();
+      if (opt.realtime) pacer.record_exec(rt::RealTimePacer::monotonic_ns() - woke);
       ++pr.scans;
       pr.campaign_ns += tick;
       if (!driver.active()) {
@@ -408,13 +423,7 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
         opt.on_progress(pr);
       }
     }
-    if (out->interrupted) {
-      // Every way out of a run on real I/O: the fault withdrawn, the safe state written.
-      runtime.input_overlay().clear();
-      runtime.output_overlay().clear();
-      runtime.write_safe_outputs();
-      break;
-    }
+    if (out->interrupted) break;  // SafeExit withdraws the fault and writes the safe state
     if (!driver.error().empty()) {
       *err = "internal error: " + driver.error();
       return false;
@@ -438,14 +447,17 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
       break;
     }
   }
-  runtime.input_overlay().clear();
-  runtime.output_overlay().clear();
-  runtime.write_safe_outputs();
   runtime.remove_hooks(&driver);
+  if (opt.realtime) {
+    out->realtime = pacer.properties();
+    out->realtime_text = fmt::format("wake latency   {}\nexecution      {}\noverruns       {} of {} cycles of {} ms",
+                                     pacer.wake_latency().summary(), pacer.exec_time().summary(), pacer.overruns(),
+                                     pacer.wake_latency().count(), static_cast<double>(pacer.period_ns()) / 1e6);
+  }
   std::vector<bool> seen(cb.cases.size(), false);
   for (const auto& e : out->executions) seen[e.case_index] = true;
   for (size_t i = 0; i < seen.size(); ++i)
-    if (!seen[i]) out->not_reached.push_back(i);
+    if (!seen[i]) (out->interrupted ? out->pending : out->not_reached).push_back(i);
   pr.cases_tested = driver.cases_tested();
   out->progress = pr;
   out->wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -66,6 +66,10 @@ struct CampaignResult {
   size_t resumed = 0;                 // executions read back from the journal
   std::string end_reason;             // "all cases tested", "search window ...", "budget ..."
   bool interrupted = false;           // stopped by a signal or lost communication (incomplete)
+  std::vector<size_t> pending;        // cases not tested because the campaign was interrupted
+  // Real-time runs: wake latency, execution time and overruns (text and JUnit properties).
+  std::string realtime_text;
+  std::vector<std::pair<std::string, std::string>> realtime;
   double wall_s = 0;
 };
 

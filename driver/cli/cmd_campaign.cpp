@@ -18,10 +18,9 @@
 #include "report/junit.hpp"
 #include "report/puml.hpp"
 
-#ifdef PLCFI_HAVE_MODBUS
-#include "io/modbus/modbus_backend.hpp"
-#endif
+#include "io/bench/bench_io.hpp"
 #include <atomic>
+#include <sstream>
 #include <csignal>
 
 namespace po = boost::program_options;
@@ -221,7 +220,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("no-vcd", "no VCD trace per test")
       ("quiet", "no live progress line")
       ("io", po::value<std::string>(), "run on real I/O: a file with an io: section (instead of the campaign's io: or plant)")
-      ("arm", "allow fault injection on real I/O (required with io:)");
+      ("arm", "allow fault injection on real I/O (required with io:)")
+      ("realtime", "pace the scans in real time (always on with real I/O); report wake latency, execution time, overruns")
+      ("rt-priority", po::value<int>()->default_value(0), "with real time: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
+      ("cpu", po::value<int>()->default_value(-1), "with real time: pin the scan thread to this CPU");
   po::variables_map vm;
   if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
   CampaignBuild cb;
@@ -265,6 +267,14 @@ int cmd_campaign(const std::vector<std::string>& args) {
   campaign::CampaignResult res;
   std::string io_path = vm.count("io") ? vm["io"].as<std::string>() : c.io;
   bool ran = false;
+  std::vector<std::string> io_report;
+  RealtimeOptions rto;
+  rto.priority = vm["rt-priority"].as<int>();
+  rto.cpu = vm["cpu"].as<int>();
+  if (rto.priority < 0 || rto.priority > 99) {
+    std::cerr << "plcfi campaign: --rt-priority must be 0..99\n";
+    return 2;
+  }
   if (!io_path.empty()) {
     if (!vm.count("arm")) {
       std::cerr << "plcfi campaign: refusing to inject faults on real I/O (" << io_path
@@ -272,16 +282,12 @@ int cmd_campaign(const std::vector<std::string>& args) {
                    "machine. Make sure the bench is safe to run and that stopping it is possible, then add --arm.\n";
       return 2;
     }
-#ifndef PLCFI_HAVE_MODBUS
-    std::cerr << "plcfi campaign: this plcfi was built without Modbus (PLCFI_MODBUS=OFF)\n";
-    return 2;
-#else
     io::IoConfig io_cfg;
     if (!io::load_io_config(io_path, *cb.build->app, &io_cfg, &err)) {
       std::cerr << err << "\n";
       return 2;
     }
-    auto backend = io::ModbusBackend::create(io_cfg, cb.schedule.tick_ns(), &err);
+    auto backend = io::BenchIo::open(io_cfg, cb.schedule.tick_ns(), &err);
     if (!backend) {
       std::cerr << err << "\n";
       return 2;
@@ -290,19 +296,25 @@ int cmd_campaign(const std::vector<std::string>& args) {
     std::signal(SIGTERM, on_campaign_signal);
     std::signal(SIGPIPE, SIG_IGN);
     opt.realtime = true;
+    realtime_setup(rto, "plcfi campaign");
     opt.stop = [] { return g_campaign_stop.load(); };
-    auto* mb = backend.get();
-    opt.io_lost = [mb]() -> std::string {
-      size_t d = mb->lost_device();
-      return d == SIZE_MAX ? "" : mb->stats()[d].last_error;
-    };
+    auto* bench = backend.get();
+    opt.io_lost = [bench] { return bench->lost(); };
     opt.safe_state = io_cfg.safe_state;
     std::cout << fmt::format("  armed: real I/O over {} in real time; SIGINT/SIGTERM withdraw the fault and write the safe state\n",
                              io_path);
     ran = campaign::run_campaign_on(cb, backend.get(), opt, &res, &err);
     backend->close();
-#endif
+    io_report = backend->report();
   } else {
+    if (vm.count("realtime")) {
+      // The simulated plant at the speed of the real one: a rehearsal of the bench run.
+      std::signal(SIGINT, on_campaign_signal);
+      std::signal(SIGTERM, on_campaign_signal);
+      opt.realtime = true;
+      opt.stop = [] { return g_campaign_stop.load(); };
+      realtime_setup(rto, "plcfi campaign");
+    }
     ran = campaign::run_campaign(cb, opt, &res, &err);
   }
   if (!ran) {
@@ -342,6 +354,11 @@ int cmd_campaign(const std::vector<std::string>& args) {
                              pad(std::to_string(tc.rpn), 4), pad(tc.transition_ref(), 30),
                              "precondition never held: " + tc.precondition);
   }
+  for (size_t i : res.pending) {
+    const auto& tc = cb.cases[i];
+    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad("-", 5), pad("NOT TESTED", 12), pad("-", 9),
+                             pad(std::to_string(tc.rpn), 4), pad(tc.transition_ref(), 30), "campaign interrupted before this case");
+  }
   const auto& p = res.progress;
   std::cout << fmt::format(
       "\n{} execution(s) of {} case(s): {} PASS, {} FAIL, {} NOT REACHED\n", res.executions.size(), cb.cases.size(), pass,
@@ -349,6 +366,11 @@ int cmd_campaign(const std::vector<std::string>& args) {
   std::cout << fmt::format("{} run(s), {} scans, {:.1f} s on the scan clock in {:.3f} s wall time; ended: {}\n", p.run,
                            p.scans, static_cast<double>(p.campaign_ns) * 1e-9, res.wall_s, res.end_reason);
   std::cout << fmt::format("journal {}/results.jsonl, traces and diagrams in {}\n", out, out);
+  if (!res.realtime_text.empty()) {
+    std::istringstream lines(res.realtime_text);
+    for (std::string l; std::getline(lines, l);) std::cout << "  " << l << "\n";
+  }
+  for (const auto& l : io_report) std::cout << "  " << l << "\n";
 
   if (vm.count("junit")) {
     report::JunitSuite suite;
@@ -373,6 +395,18 @@ int cmd_campaign(const std::vector<std::string>& args) {
                        {"fault", fault_text(tc)},
                        {"latency_ms", e.latency_ns >= 0 ? fmt::format("{:.1f}", static_cast<double>(e.latency_ns) * 1e-6) : ""},
                        {"vcd", e.vcd}};
+      suite.cases.push_back(jc);
+    }
+    suite.properties = res.realtime;
+    for (size_t i = 0; i < io_report.size(); ++i) suite.properties.emplace_back(fmt::format("io_{}", i), io_report[i]);
+    if (res.interrupted) suite.properties.emplace_back("incomplete", res.end_reason);
+    for (size_t i : res.pending) {
+      const auto& tc = cb.cases[i];
+      report::JunitCase jc;
+      jc.classname = suite.name + "." + tc.transition_ref();
+      jc.name = fmt::format("{}: {}", tc.id, tc.row->failure_mode);
+      jc.outcome = report::JunitCase::Outcome::Skipped;
+      jc.message = "not tested: the campaign was interrupted (" + res.end_reason + "); finish it with --resume";
       suite.cases.push_back(jc);
     }
     for (size_t i : res.not_reached) {

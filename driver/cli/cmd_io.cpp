@@ -16,12 +16,13 @@
 #include "commands.hpp"
 #include "engine.hpp"
 #include "plant_model/plant.hpp"
+#include "report/junit.hpp"
 #include "runtime/clock.hpp"
 #include "runtime/runtime.hpp"
 #include "runtime/schedule.hpp"
 
+#include "io/bench/bench_io.hpp"
 #ifdef PLCFI_HAVE_MODBUS
-#include "io/modbus/modbus_backend.hpp"
 #include "io/modbus/plant_server.hpp"
 #endif
 
@@ -37,9 +38,11 @@ void on_signal(int s) {
   g_stop.store(true);
 }
 
+}  // namespace
+
 // Real-time set-up of the scan thread; each step that fails is reported and skipped (a
 // bench run without privileges still runs, with worse latency).
-void realtime_setup(const RealtimeOptions& o) {
+void realtime_setup(const RealtimeOptions& o, const char* who) {
   prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
   // Keep the CPUs out of deep idle states while the run lasts (PM QoS, as cyclictest
   // does): the request holds while the file stays open, so it is never closed here.
@@ -53,38 +56,33 @@ void realtime_setup(const RealtimeOptions& o) {
     }
   }
   if (o.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-    std::cerr << "plcfi run: warning: mlockall: " << std::strerror(errno) << " (page faults may add latency)\n";
+    std::cerr << who << ": warning: mlockall: " << std::strerror(errno) << " (page faults may add latency)\n";
   if (o.cpu >= 0) {
     cpu_set_t set;
     CPU_ZERO(&set);
     CPU_SET(o.cpu, &set);
     if (sched_setaffinity(0, sizeof set, &set) != 0)
-      std::cerr << "plcfi run: warning: CPU affinity " << o.cpu << ": " << std::strerror(errno) << "\n";
+      std::cerr << who << ": warning: CPU affinity " << o.cpu << ": " << std::strerror(errno) << "\n";
   }
   if (o.priority > 0) {
     sched_param sp{};
     sp.sched_priority = o.priority;
     if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
-      std::cerr << "plcfi run: warning: SCHED_FIFO priority " << o.priority << ": " << std::strerror(errno) << "\n";
+      std::cerr << who << ": warning: SCHED_FIFO priority " << o.priority << ": " << std::strerror(errno) << "\n";
   }
 }
-}  // namespace
 
 int run_with_io(const st::Application& app, const rt::Schedule& sched, const std::string& io_path, const RunIoOptions& o,
                 const std::function<bool(st::Machine&)>& setup, const std::function<void(st::Machine&, int)>& report) {
-#ifndef PLCFI_HAVE_MODBUS
-  std::cerr << "plcfi run: --io needs a plcfi built with Modbus (PLCFI_MODBUS=ON)\n";
-  return 2;
-#else
   std::string err;
   io::IoConfig cfg;
-  std::unique_ptr<io::ModbusBackend> backend;
+  std::unique_ptr<io::BenchIo> backend;
   if (!io_path.empty()) {  // without an io file: the pacing alone (latency measurements)
     if (!io::load_io_config(io_path, app, &cfg, &err)) {
       std::cerr << err << "\n";
       return 2;
     }
-    backend = io::ModbusBackend::create(cfg, sched.tick_ns(), &err);
+    backend = io::BenchIo::open(cfg, sched.tick_ns(), &err);
     if (!backend) {
       std::cerr << err << "\n";
       return 2;
@@ -93,11 +91,14 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
   rt::Runtime runtime(app, sched, backend.get());
   runtime.set_safe_state(cfg.safe_state);
   runtime.cold_restart(1);
-  if (!setup(runtime.machine())) return 2;
+  if (!setup(runtime.machine())) {
+    runtime.write_safe_outputs();
+    return 2;
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::signal(SIGPIPE, SIG_IGN);
-  if (o.realtime) realtime_setup(o.rt);
+  if (o.realtime) realtime_setup(o.rt, "plcfi run");
   rt::RealTimePacer pacer(sched.tick_ns());
   pacer.start();
   uint64_t scans = 0;
@@ -121,9 +122,9 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
       status = 1;
       break;
     }
-    size_t lost = backend ? backend->lost_device() : SIZE_MAX;
-    if (lost != SIZE_MAX) {
-      why = "communication lost: " + backend->stats()[lost].last_error;
+    std::string lost = backend ? backend->lost() : "";
+    if (!lost.empty()) {
+      why = "communication lost: " + lost;
       status = 1;
       break;
     }
@@ -137,15 +138,35 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
   if (o.realtime)
     std::cout << fmt::format("  wake latency   {}\n  execution      {}\n  overruns       {}\n", pacer.wake_latency().summary(),
                              pacer.exec_time().summary(), pacer.overruns());
-  for (size_t i = 0; i < cfg.devices.size(); ++i) {
-    const auto& d = backend->stats()[i];  // cfg.devices is empty without a backend
-    std::cout << fmt::format("  device {}: {} requests, {} failed, {} connect(s), {} disconnect(s){}\n", cfg.devices[i].name,
-                             d.requests, d.failures, d.connects, d.disconnects,
-                             d.last_error.empty() ? "" : "; last error: " + d.last_error);
-  }
+  if (backend)
+    for (const auto& line : backend->report()) std::cout << "  " << line << "\n";
   report(runtime.machine(), status);
+  if (!o.junit.empty()) {
+    report::JunitSuite suite;
+    suite.name = "run";
+    report::JunitCase jc;
+    jc.classname = "run";
+    jc.name = backend ? "scan cycle on " + cfg.path : "scan cycle";
+    jc.seconds = static_cast<double>(rt::RealTimePacer::monotonic_ns() - t0) * 1e-9;
+    if (status != 0) {
+      jc.outcome = report::JunitCase::Outcome::Fail;
+      jc.message = why;
+    }
+    jc.properties.emplace_back("scans", std::to_string(scans));
+    jc.properties.emplace_back("ended", why);
+    if (o.realtime)
+      for (const auto& p : pacer.properties()) suite.properties.push_back(p);
+    if (backend) {
+      int n = 0;
+      for (const auto& line : backend->report()) suite.properties.emplace_back(fmt::format("io_{}", n++), line);
+    }
+    suite.cases.push_back(jc);
+    if (!report::write_junit(o.junit, {suite}, &err)) {
+      std::cerr << "plcfi run: " << err << "\n";
+      return 2;
+    }
+  }
   return status;
-#endif
 }
 
 int cmd_plant_server(const std::vector<std::string>& args) {

@@ -111,9 +111,10 @@ int cmd_run(const std::vector<std::string>& args) {
       ("realtime", "pace the scans on absolute real-time deadlines and report wake latency (with or without --io)")
       ("duration", po::value<std::string>(), "with --io or --realtime: run this long (e.g. 10s); SIGINT/SIGTERM also end the run")
       ("rt-priority", po::value<int>()->default_value(0), "with --realtime: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
-      ("cpu", po::value<int>()->default_value(-1), "with --realtime: pin the scan thread to this CPU");
+      ("cpu", po::value<int>()->default_value(-1), "with --realtime: pin the scan thread to this CPU")
+      ("junit", po::value<std::string>(), "with --io or --realtime: JUnit XML with the wake latency, execution time and overruns as properties");
   po::variables_map vm;
-  if (!parse(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE [--realtime] [--duration T]]")) return 0;
+  if (!parse(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE] [--realtime [--rt-priority N] [--cpu N]] [--duration T] [--junit F]")) return 0;
   st::CompileOptions opt;
   opt.warnings = false;
   auto b = load(files_of(vm), opt, "run");
@@ -142,6 +143,7 @@ int cmd_run(const std::vector<std::string>& args) {
     o.realtime = vm.count("realtime") > 0;
     o.rt.priority = vm["rt-priority"].as<int>();
     o.rt.cpu = vm["cpu"].as<int>();
+    if (vm.count("junit")) o.junit = vm["junit"].as<std::string>();
     if (o.rt.priority < 0 || o.rt.priority > 99) {
       std::cerr << "plcfi run: --rt-priority must be 0..99\n";
       return 2;

@@ -28,11 +28,16 @@ struct RealtimeOptions {
   int cpu = -1;      // CPU affinity (-1: any)
   bool lock_memory = true;
 };
+// Timer slack, PM QoS, mlockall, affinity, SCHED_FIFO for the calling thread; a step that
+// fails is reported on stderr (prefixed by `who`) and skipped.
+void realtime_setup(const RealtimeOptions& o, const char* who);
+
 struct RunIoOptions {
   uint64_t cycles = 0;      // 0: no limit
   int64_t duration_ns = 0;  // 0: no limit
   bool realtime = false;
   RealtimeOptions rt;
+  std::string junit;        // JUnit XML with the real-time figures as properties ("": none)
 };
 // setup() runs once after the cold restart (--set); report() at the end (--print).
 int run_with_io(const st::Application& app, const rt::Schedule& sched, const std::string& io_path, const RunIoOptions& o,

@@ -1,6 +1,7 @@
 // Parsing of the `io:` section (devices and image mappings).
 #include "io_config.hpp"
 
+#include <cctype>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -16,6 +17,25 @@ const char* table_name(ModbusTable t) {
     case ModbusTable::DiscreteInputs: return "discrete_inputs";
     case ModbusTable::HoldingRegisters: return "holding_registers";
     case ModbusTable::InputRegisters: return "input_registers";
+  }
+  return "?";
+}
+
+const char* bias_name(GpioBias b) {
+  switch (b) {
+    case GpioBias::AsIs: return "as-is";
+    case GpioBias::Disabled: return "disabled";
+    case GpioBias::PullUp: return "pull-up";
+    case GpioBias::PullDown: return "pull-down";
+  }
+  return "?";
+}
+
+const char* drive_name(GpioDrive d) {
+  switch (d) {
+    case GpioDrive::PushPull: return "push-pull";
+    case GpioDrive::OpenDrain: return "open-drain";
+    case GpioDrive::OpenSource: return "open-source";
   }
   return "?";
 }
@@ -74,15 +94,29 @@ class Reader {
     return r;
   }
 
-  void device(const YAML::Node& n, IoConfig* cfg) const {
+  void device(const YAML::Node& n, IoConfig* cfg) {
+    if (!n.IsMap()) fail(n, "a device must be a map (name:, and tcp:, rtu: or gpio:)");
+    if (!n["name"]) fail(n, "a device needs a name");
+    std::string name = str(n["name"], "name");
+    for (const auto& other : cfg->devices)
+      if (other.name == name) fail(n["name"], "device '" + name + "' is defined twice");
+    for (const auto& other : cfg->gpio_devices)
+      if (other.name == name) fail(n["name"], "device '" + name + "' is defined twice");
+    if (n["gpio"]) {
+      keys(n, {"name", "gpio"}, "a GPIO device");
+      GpioDevice g;
+      g.where = at(n);
+      g.name = name;
+      g.chip = str(n["gpio"], "gpio");
+      if (g.chip.empty()) fail(n["gpio"], "gpio names a chip: gpiochip0, /dev/gpiochip0, its label or its number");
+      cfg->gpio_devices.push_back(g);
+      return;
+    }
     keys(n, {"name", "tcp", "rtu", "unit", "timeout", "status", "reconnect", "lost_after", "reset_register"}, "a device");
     ModbusDevice d;
     d.where = at(n);
-    if (!n["name"]) fail(n, "a device needs a name");
-    d.name = str(n["name"], "name");
-    for (const auto& other : cfg->devices)
-      if (other.name == d.name) fail(n["name"], "device '" + d.name + "' is defined twice");
-    if (bool(n["tcp"]) == bool(n["rtu"])) fail(n, "a device is either tcp: HOST:PORT or rtu: {device: ...}");
+    d.name = name;
+    if (bool(n["tcp"]) == bool(n["rtu"])) fail(n, "a device is either tcp: HOST:PORT, rtu: {device: ...} or gpio: CHIP");
     if (n["tcp"]) {
       // "host:port", "[v6::addr]:port" or "host" (port 502).
       std::string t = str(n["tcp"], "tcp");
@@ -131,6 +165,8 @@ class Reader {
       d.status = image(n["status"], "status");
       if (d.status.area != 'I' || !d.status.is_bit) fail(n["status"], "status must be an input bit (%IXn.m)");
       d.has_status = true;
+      uint64_t b = d.status.offset * 8u + d.status.bit;
+      claim(n["status"], 'I', b, b + 1, d.where);
     }
     if (const YAML::Node rc = n["reconnect"]) {
       keys(rc, {"min", "max"}, "reconnect");
@@ -143,15 +179,90 @@ class Reader {
     cfg->devices.push_back(d);
   }
 
-  void point(const YAML::Node& n, IoConfig* cfg) const {
+  // Two mappings must not feed the same image bits (which one would win?).
+  void claim(const YAML::Node& at_node, char area, uint64_t bit0, uint64_t bit1, const std::string& where) {
+    for (const auto& r : ranges_)
+      if (r.area == area && bit0 < r.bit1 && r.bit0 < bit1) fail(at_node, "overlaps the mapping at " + r.where);
+    ranges_.push_back({area, bit0, bit1, where});
+  }
+
+  void gpio_point(const YAML::Node& n, size_t device, IoConfig* cfg) {
+    keys(n, {"image", "device", "lines", "active_low", "bias", "drive"}, "a GPIO mapping");
+    GpioPoint p;
+    p.where = at(n);
+    p.device = device;
+    if (!n["image"]) fail(n, "a mapping needs image: (the first %IX/%QX bit)");
+    p.image = image(n["image"], "image");
+    if (!p.image.is_bit || (p.image.area != 'I' && p.image.area != 'Q'))
+      fail(n["image"], "GPIO lines map to bits: %IXn.m (inputs) or %QXn.m (outputs)");
+    const YAML::Node lines = n["lines"];
+    if (!lines) fail(n, "a GPIO mapping needs lines: [offsets or line names]");
+    if (lines.IsScalar()) fail(lines, "lines is a list, e.g. [0, 1, 2] or [START, STOP]");
+    if (!lines.IsSequence() || lines.size() == 0) fail(lines, "lines is a non-empty list of offsets or line names");
+    if (lines.size() > 64) fail(lines, "at most 64 lines per mapping (one bulk request)");
+    for (const auto& l : lines) {
+      GpioPoint::Line line;
+      std::string t = str(l, "a line");
+      if (!t.empty() && std::isdigit(static_cast<unsigned char>(t[0])))
+        line.offset = static_cast<int>(integer(l, "line offset", 0, 65535));
+      else if (t.empty())
+        fail(l, "empty line name");
+      else
+        line.name = t;
+      for (const auto& q : cfg->gpio_points) {
+        if (q.device != device) continue;
+        for (const auto& o : q.lines)
+          if ((line.offset >= 0 && o.offset == line.offset) || (!line.name.empty() && o.name == line.name))
+            fail(l, "line " + t + " is already mapped at " + q.where);
+      }
+      for (const auto& o : p.lines)
+        if ((line.offset >= 0 && o.offset == line.offset) || (!line.name.empty() && o.name == line.name))
+          fail(l, "line " + t + " is listed twice");
+      p.lines.push_back(line);
+    }
+    if (n["active_low"]) {
+      std::string v = str(n["active_low"], "active_low");
+      if (v == "true" || v == "TRUE") p.active_low = true;
+      else if (v == "false" || v == "FALSE") p.active_low = false;
+      else fail(n["active_low"], "active_low is true or false");
+    }
+    if (n["bias"]) {
+      std::string v = str(n["bias"], "bias");
+      if (v == "as-is") p.bias = GpioBias::AsIs;
+      else if (v == "disabled") p.bias = GpioBias::Disabled;
+      else if (v == "pull-up") p.bias = GpioBias::PullUp;
+      else if (v == "pull-down") p.bias = GpioBias::PullDown;
+      else fail(n["bias"], "bias is as-is, disabled, pull-up or pull-down");
+      if (p.image.area == 'Q') fail(n["bias"], "bias applies to inputs (%IX)");
+    }
+    if (n["drive"]) {
+      std::string v = str(n["drive"], "drive");
+      if (v == "push-pull") p.drive = GpioDrive::PushPull;
+      else if (v == "open-drain") p.drive = GpioDrive::OpenDrain;
+      else if (v == "open-source") p.drive = GpioDrive::OpenSource;
+      else fail(n["drive"], "drive is push-pull, open-drain or open-source");
+      if (p.image.area == 'I') fail(n["drive"], "drive applies to outputs (%QX)");
+    }
+    uint32_t area_size = p.image.area == 'I' ? app_.image_i.size : app_.image_q.size;
+    uint64_t b0 = p.image.offset * 8u + p.image.bit, b1 = b0 + p.lines.size();
+    if ((b1 + 7) / 8 > area_size)
+      fail(n["lines"], fmt::format("the range ends beyond the %{} image ({} bytes)", p.image.area, area_size));
+    claim(n["image"], p.image.area, b0, b1, p.where);
+    cfg->gpio_points.push_back(p);
+  }
+
+  void point(const YAML::Node& n, IoConfig* cfg) {
+    if (!n.IsMap()) fail(n, "a mapping must be a map (image:, device:, ...)");
+    if (!n["device"]) fail(n, "a mapping needs a device");
+    std::string dev = str(n["device"], "device");
+    for (size_t i = 0; i < cfg->gpio_devices.size(); ++i)
+      if (cfg->gpio_devices[i].name == dev) return gpio_point(n, i, cfg);
     keys(n, {"image", "count", "device", "coils", "discrete_inputs", "holding_registers", "input_registers"}, "a mapping");
     ModbusPoint p;
     p.where = at(n);
     if (!n["image"]) fail(n, "a mapping needs image: (the first %I/%Q address)");
     p.image = image(n["image"], "image");
     if (n["count"]) p.count = static_cast<int>(integer(n["count"], "count", 1, 2000));
-    if (!n["device"]) fail(n, "a mapping needs a device");
-    std::string dev = str(n["device"], "device");
     p.device = SIZE_MAX;
     for (size_t i = 0; i < cfg->devices.size(); ++i)
       if (cfg->devices[i].name == dev) p.device = i;
@@ -180,22 +291,21 @@ class Reader {
     uint32_t end = bits ? (p.image.offset * 8 + p.image.bit + static_cast<uint32_t>(p.count) + 7) / 8
                         : p.image.offset + 2 * static_cast<uint32_t>(p.count);
     if (end > area_size) fail(n["count"] ? n["count"] : n["image"], fmt::format("the range ends beyond the %{} image ({} bytes)", p.image.area, area_size));
-    // Two mappings must not feed the same image bytes (which one would win?).
-    for (const auto& q : cfg->points) {
-      if (q.image.area != p.image.area) continue;
-      bool qbits = q.table == ModbusTable::Coils || q.table == ModbusTable::DiscreteInputs;
-      uint64_t a0 = bits ? p.image.offset * 8u + p.image.bit : p.image.offset * 8u;
-      uint64_t a1 = a0 + (bits ? p.count : 16u * static_cast<uint32_t>(p.count));
-      uint64_t b0 = qbits ? q.image.offset * 8u + q.image.bit : q.image.offset * 8u;
-      uint64_t b1 = b0 + (qbits ? q.count : 16u * static_cast<uint32_t>(q.count));
-      if (a0 < b1 && b0 < a1) fail(n["image"], "overlaps the mapping at " + q.where);
-    }
+    uint64_t a0 = bits ? p.image.offset * 8u + p.image.bit : p.image.offset * 8u;
+    uint64_t a1 = a0 + (bits ? p.count : 16u * static_cast<uint32_t>(p.count));
+    claim(n["image"], p.image.area, a0, a1, p.where);
     cfg->points.push_back(p);
   }
 
  private:
+  struct Range {
+    char area;
+    uint64_t bit0, bit1;
+    std::string where;
+  };
   std::string path_;
   const st::Application& app_;
+  std::vector<Range> ranges_;
 };
 
 }  // namespace

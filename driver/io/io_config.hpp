@@ -1,5 +1,5 @@
-// The `io:` section of run and campaign files: which devices exist (Modbus TCP/RTU units)
-// and which image ranges map to which of their points. Parsed and checked against the
+// The `io:` section of run and campaign files: which devices exist (Modbus TCP/RTU units,
+// GPIO chips) and which image ranges map to which of their points. Parsed and checked against the
 // application's image once, before the first scan; errors name FILE:LINE:COL.
 #pragma once
 
@@ -46,13 +46,43 @@ struct ModbusPoint {
   std::string where;
 };
 
+// A GPIO chip (libgpiod): by name (gpiochip0), path (/dev/gpiochip0), label or number.
+struct GpioDevice {
+  std::string name;
+  std::string chip;
+  std::string where;
+};
+
+enum class GpioBias { AsIs, Disabled, PullUp, PullDown };
+enum class GpioDrive { PushPull, OpenDrain, OpenSource };
+const char* bias_name(GpioBias b);
+const char* drive_name(GpioDrive d);
+
+// Lines of one chip to consecutive image bits from `image` (%IX: inputs, %QX: outputs).
+// Each line is an offset or a line name (resolved when the chip is opened).
+struct GpioPoint {
+  size_t device = 0;  // index in gpio_devices
+  struct Line {
+    int offset = -1;   // -1: by name
+    std::string name;
+  };
+  std::vector<Line> lines;
+  rt::ImageRef image;
+  bool active_low = false;
+  GpioBias bias = GpioBias::AsIs;
+  GpioDrive drive = GpioDrive::PushPull;
+  std::string where;
+};
+
 struct IoConfig {
   std::string path;
-  std::vector<ModbusDevice> devices;
+  std::vector<ModbusDevice> devices;  // Modbus units
   std::vector<ModbusPoint> points;
+  std::vector<GpioDevice> gpio_devices;
+  std::vector<GpioPoint> gpio_points;
   // Outputs whose safe value is not 0 (written on every way out; all others go to 0).
   std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
-  bool empty() const { return devices.empty(); }
+  bool empty() const { return devices.empty() && gpio_devices.empty(); }
 };
 
 // Reads the `io:` section of `path` (a file whose top level has `io:`, or that is the

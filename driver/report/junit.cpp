@@ -38,6 +38,12 @@ std::string junit_xml(const std::vector<JunitSuite>& suites) {
     }
     out += fmt::format("  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" skipped=\"{}\" time=\"{:.6f}\">\n",
                        xml_escape(s.name), s.cases.size(), failures, errors, skipped, time);
+    if (!s.properties.empty()) {
+      out += "    <properties>\n";
+      for (const auto& [k, v] : s.properties)
+        out += fmt::format("      <property name=\"{}\" value=\"{}\"/>\n", xml_escape(k), xml_escape(v));
+      out += "    </properties>\n";
+    }
     for (const auto& c : s.cases) {
       out += fmt::format("    <testcase classname=\"{}\" name=\"{}\" time=\"{:.6f}\"", xml_escape(c.classname), xml_escape(c.name), c.seconds);
       if (c.outcome == JunitCase::Outcome::Pass && c.properties.empty()) {

@@ -19,6 +19,7 @@ struct JunitCase {
 struct JunitSuite {
   std::string name;
   std::vector<JunitCase> cases;
+  std::vector<std::pair<std::string, std::string>> properties;  // of the whole run (e.g. real-time statistics)
 };
 
 std::string junit_xml(const std::vector<JunitSuite>& suites);

@@ -44,6 +44,21 @@ std::string LatencyStats::summary() const {
                      us(static_cast<double>(percentile(0.99))), us(static_cast<double>(max())));
 }
 
+std::vector<std::pair<std::string, std::string>> RealTimePacer::properties() const {
+  std::vector<std::pair<std::string, std::string>> p;
+  auto us_text = [](double ns) { return fmt::format("{:.1f}", ns / 1000.0); };
+  p.emplace_back("cycle_ms", fmt::format("{:g}", static_cast<double>(period_ns_) / 1e6));
+  p.emplace_back("cycles", std::to_string(latency_.count()));
+  p.emplace_back("overruns", std::to_string(overruns_));
+  for (const auto& [name, s] : {std::pair<const char*, const LatencyStats*>{"wake_latency", &latency_}, {"execution", &exec_}}) {
+    p.emplace_back(std::string(name) + "_min_us", us_text(static_cast<double>(s->min())));
+    p.emplace_back(std::string(name) + "_avg_us", us_text(s->avg()));
+    p.emplace_back(std::string(name) + "_p99_us", us_text(static_cast<double>(s->percentile(0.99))));
+    p.emplace_back(std::string(name) + "_max_us", us_text(static_cast<double>(s->max())));
+  }
+  return p;
+}
+
 int64_t RealTimePacer::monotonic_ns() {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);

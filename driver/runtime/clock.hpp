@@ -47,6 +47,9 @@ class RealTimePacer {
   const LatencyStats& exec_time() const { return exec_; }
   uint64_t overruns() const { return overruns_; }
   int64_t period_ns() const { return period_ns_; }
+  // The figures as name/value pairs (JUnit properties): cycle_ms, cycles, overruns,
+  // wake_latency_{min,avg,p99,max}_us, execution_{min,avg,p99,max}_us.
+  std::vector<std::pair<std::string, std::string>> properties() const;
 
  private:
   int64_t period_ns_;

@@ -69,7 +69,7 @@ int free_port() {
   return ntohs(a.sin_port);
 }
 
-class Fixture : public ::testing::Test {
+class ModbusIo : public ::testing::Test {
  public:
   void SetUp() override {
     b_ = st::build_sources({{"p.st", kProgram}}, st::CompileOptions{});
@@ -118,7 +118,7 @@ class Fixture : public ::testing::Test {
 
 // ------------------------------------------------------------------ configuration
 
-TEST_F(Fixture, IoSectionErrorsNameTheLine) {
+TEST_F(ModbusIo, IoSectionErrorsNameTheLine) {
   struct Case {
     std::string text;
     const char* expect;
@@ -143,7 +143,7 @@ TEST_F(Fixture, IoSectionErrorsNameTheLine) {
   }
 }
 
-TEST_F(Fixture, Ipv6AndHostNamesParse) {
+TEST_F(ModbusIo, Ipv6AndHostNamesParse) {
   IoConfig cfg;
   std::string err;
   std::string text = "io:\n  devices:\n    - {name: a, tcp: \"[::1]:1502\"}\n    - {name: b, tcp: \"localhost\"}\n"
@@ -235,7 +235,7 @@ class LibmodbusServer {
   std::atomic<bool> stop_{false};
 };
 
-TEST_F(Fixture, ExchangesTheImageInTheScan) {
+TEST_F(ModbusIo, ExchangesTheImageInTheScan) {
   int port = free_port();
   LibmodbusServer server(port);
   auto mb = backend(io_text("tcp: \"127.0.0.1:" + std::to_string(port) + "\""));
@@ -257,7 +257,7 @@ TEST_F(Fixture, ExchangesTheImageInTheScan) {
   EXPECT_EQ(mb->stats()[0].failures, 0u);
 }
 
-TEST_F(Fixture, KeepsLastGoodInputsAndReconnectsAfterAnOutage) {
+TEST_F(ModbusIo, KeepsLastGoodInputsAndReconnectsAfterAnOutage) {
   int port = free_port();
   auto server = std::make_unique<LibmodbusServer>(port);
   auto mb = backend(io_text("tcp: \"127.0.0.1:" + std::to_string(port) + "\""));
@@ -282,7 +282,7 @@ TEST_F(Fixture, KeepsLastGoodInputsAndReconnectsAfterAnOutage) {
   EXPECT_EQ(get(r, "P.ir"), 41);
 }
 
-TEST_F(Fixture, UnreachableDeviceNeitherHangsNorCrashes) {
+TEST_F(ModbusIo, UnreachableDeviceNeitherHangsNorCrashes) {
   int port = free_port();  // nobody listens
   auto mb = backend(io_text("tcp: \"127.0.0.1:" + std::to_string(port) + "\"\n      lost_after: 100ms"));
   ASSERT_TRUE(mb);
@@ -322,7 +322,7 @@ class Child {
 
 const std::string kServer = std::string(PLCFI_SOURCE_DIR) + "/tests/io/modbus_test_server.py";
 
-void check_against_pymodbus(Fixture& f, rt::Runtime& r, ModbusBackend& mb) {
+void check_against_pymodbus(ModbusIo& f, rt::Runtime& r, ModbusBackend& mb) {
   // pymodbus: DI 0..2 = 1,0,1; IR0 = 100; IR3 = 65535 (-1 as INT).
   ASSERT_TRUE(f.scan_until(r, [&] { return f.get(r, "P.linkOk") == 1 && f.get(r, "P.ir") == 100; })) << mb.last_error();
   EXPECT_EQ(f.get(r, "P.di0"), 1);
@@ -331,7 +331,7 @@ void check_against_pymodbus(Fixture& f, rt::Runtime& r, ModbusBackend& mb) {
   EXPECT_EQ(f.get(r, "P.ir3"), -1);
 }
 
-TEST_F(Fixture, AgainstPymodbusOverTcp) {
+TEST_F(ModbusIo, AgainstPymodbusOverTcp) {
   int port = free_port();
   Child server({"/usr/bin/python3", kServer, "--tcp", std::to_string(port)});
   ASSERT_TRUE(server.ok());
@@ -352,7 +352,7 @@ TEST_F(Fixture, AgainstPymodbusOverTcp) {
   }));
 }
 
-TEST_F(Fixture, AgainstPymodbusOverRtuOnAPtyPair) {
+TEST_F(ModbusIo, AgainstPymodbusOverRtuOnAPtyPair) {
   fs::path dir = fs::temp_directory_path() / ("plcfi_rtu_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   std::string a = (dir / "a").string(), b = (dir / "b").string();

@@ -1,0 +1,121 @@
+// Bench I/O: Modbus and GPIO backends combined.
+#include "bench_io.hpp"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#ifdef PLCFI_HAVE_MODBUS
+#include "io/modbus/modbus_backend.hpp"
+#endif
+#ifdef PLCFI_HAVE_GPIO
+#include "io/gpio/gpio_backend.hpp"
+#endif
+
+namespace plcfi::io {
+
+std::unique_ptr<BenchIo> BenchIo::open(const IoConfig& cfg, int64_t cycle_ns, std::string* err) {
+  std::unique_ptr<BenchIo> b(new BenchIo());
+  b->cfg_ = cfg;
+  if (!cfg.devices.empty()) {
+#ifdef PLCFI_HAVE_MODBUS
+    b->modbus_ = ModbusBackend::create(b->cfg_, cycle_ns, err);
+    if (!b->modbus_) return nullptr;
+    b->parts_.push_back(b->modbus_.get());
+#else
+    (void)cycle_ns;
+    *err = cfg.devices[0].where + ": device '" + cfg.devices[0].name + "': this plcfi was built without Modbus (PLCFI_MODBUS=OFF)";
+    return nullptr;
+#endif
+  }
+  if (!cfg.gpio_devices.empty()) {
+#ifdef PLCFI_HAVE_GPIO
+    b->gpio_ = GpioBackend::open(b->cfg_, err);
+    if (!b->gpio_) return nullptr;
+    b->parts_.push_back(b->gpio_.get());
+#else
+    *err = cfg.gpio_devices[0].where + ": device '" + cfg.gpio_devices[0].name + "': this plcfi was built without GPIO (PLCFI_GPIO=OFF)";
+    return nullptr;
+#endif
+  }
+  return b;
+}
+
+BenchIo::~BenchIo() { close(); }
+
+uint32_t BenchIo::input_extent() const {
+  uint32_t e = 0;
+  for (auto* p : parts_) e = std::max(e, p->input_extent());
+  return e;
+}
+
+uint32_t BenchIo::output_extent() const {
+  uint32_t e = 0;
+  for (auto* p : parts_) e = std::max(e, p->output_extent());
+  return e;
+}
+
+bool BenchIo::read(uint8_t* inputs, int64_t now_ns) {
+  bool ok = true;
+  for (auto* p : parts_)
+    if (!p->read(inputs, now_ns)) {
+      ok = false;
+      error_ = p->last_error();
+    }
+  return ok;
+}
+
+bool BenchIo::write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) {
+  bool ok = true;
+  for (auto* p : parts_)
+    if (!p->write(outputs, now_ns, dt_ns)) {
+      ok = false;
+      error_ = p->last_error();
+    }
+  return ok;
+}
+
+void BenchIo::reset(uint64_t seed) {
+  for (auto* p : parts_) p->reset(seed);
+}
+
+std::string BenchIo::lost() const {
+#ifdef PLCFI_HAVE_MODBUS
+  if (modbus_) {
+    size_t d = modbus_->lost_device();
+    if (d != SIZE_MAX) return modbus_->stats()[d].last_error;
+  }
+#endif
+  return "";
+}
+
+std::vector<std::string> BenchIo::report() const {
+  std::vector<std::string> out;
+#ifdef PLCFI_HAVE_MODBUS
+  if (modbus_)
+    for (size_t i = 0; i < cfg_.devices.size(); ++i) {
+      const auto& d = modbus_->stats()[i];
+      out.push_back(fmt::format("device {}: {} requests, {} failed, {} connect(s), {} disconnect(s){}", cfg_.devices[i].name,
+                                d.requests, d.failures, d.connects, d.disconnects,
+                                d.last_error.empty() ? "" : "; last error: " + d.last_error));
+    }
+#endif
+#ifdef PLCFI_HAVE_GPIO
+  if (gpio_) {
+    for (const auto& l : gpio_->describe()) out.push_back("gpio " + l);
+    if (gpio_->failures()) out.push_back(fmt::format("gpio: {} failed line operations; last error: {}", gpio_->failures(), gpio_->last_error()));
+  }
+#endif
+  return out;
+}
+
+void BenchIo::close() {
+#ifdef PLCFI_HAVE_MODBUS
+  if (modbus_) modbus_->close();
+#endif
+#ifdef PLCFI_HAVE_GPIO
+  if (gpio_) gpio_->close();
+#endif
+}
+
+}  // namespace plcfi::io

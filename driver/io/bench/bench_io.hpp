@@ -1,0 +1,49 @@
+// The I/O of a bench run: every backend an `io:` section names (Modbus units, GPIO chips)
+// behind one IoBackend, plus what the run loop needs to know about them: whether a
+// device has been lost for longer than allowed, and their statistics for the end report.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "io/io_config.hpp"
+#include "runtime/backend.hpp"
+
+namespace plcfi::io {
+
+class ModbusBackend;
+class GpioBackend;
+
+class BenchIo final : public rt::IoBackend {
+ public:
+  // Opens (GPIO) or prepares (Modbus: connects in the first read) every backend of cfg.
+  static std::unique_ptr<BenchIo> open(const IoConfig& cfg, int64_t cycle_ns, std::string* err);
+  ~BenchIo() override;
+
+  const std::string& name() const override { return name_; }
+  uint32_t input_extent() const override;
+  uint32_t output_extent() const override;
+  bool read(uint8_t* inputs, int64_t now_ns) override;
+  bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) override;
+  void reset(uint64_t seed) override;
+  const std::string& last_error() const override { return error_; }
+
+  // "" or the lost device's last error (down longer than its lost_after).
+  std::string lost() const;
+  // One line per device or request: requests, failures, (re)connects, last error.
+  std::vector<std::string> report() const;
+  const IoConfig& config() const { return cfg_; }
+  // Closes every backend; the caller writes the safe state before.
+  void close();
+
+ private:
+  BenchIo() = default;
+  IoConfig cfg_;
+  std::vector<rt::IoBackend*> parts_;
+  std::unique_ptr<ModbusBackend> modbus_;
+  std::unique_ptr<GpioBackend> gpio_;
+  std::string name_ = "bench", error_;
+};
+
+}  // namespace plcfi::io
