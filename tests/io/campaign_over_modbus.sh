@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The stamping campaign (three FMEA rows: StampLowered on two automatic paths, the
 # pressure, the initialization run) over Modbus TCP against `plcfi plant-server` in real
-# time gives the same verdicts as offline; without --arm it refuses to inject.
+# time gives the same verdicts as offline; without --arm it refuses to inject; SIGINT
+# mid-campaign withdraws the fault, leaves the safe state on the coils and reports the
+# campaign incomplete, and --resume finishes it with the same verdicts.
 # usage: campaign_over_modbus.sh PLCFI SOURCE_DIR
 set -euo pipefail
 plcfi=$1
@@ -40,9 +42,31 @@ for _ in $(seq 1 200); do grep -q listening "$work"/server.log && break; sleep 0
 cat "$work"/bench.txt
 verdicts "$work"/bench.txt | tee "$work"/bench.v
 diff "$work"/offline.v "$work"/bench.v
+grep -q "wake latency   min" "$work"/bench.txt
+
+echo "== SIGINT mid-campaign, then --resume"
+"$plcfi" campaign "$work"/bench.yaml --arm --out "$work"/bench2 --quiet --no-vcd --junit "$work"/bench2.xml > "$work"/bench2.txt 2>&1 &
+run=$!
+sleep 7
+kill -INT $run
+status=0
+wait $run || status=$?
+cat "$work"/bench2.txt
+test $status -eq 1
+grep -q "campaign incomplete (interrupted by a signal); finish it with --resume" "$work"/bench2.txt
+grep -q '<property name="incomplete" value="interrupted by a signal"/>' "$work"/bench2.xml
+grep -q '<property name="wake_latency_p99_us"' "$work"/bench2.xml
+coils=$(mbpoll -m tcp -a 1 -t 0 -r 1 -c 7 -1 -p "$port" 127.0.0.1 | sed -n 's/^\[\([0-9]*\)\]:[[:space:]]*\([01]\)$/\2/p' | tr -d '\n')
+echo "coils after SIGINT: $coils"
+test "$coils" = 1000000   # the io file's safe state: the slider valve on, all else off
+"$plcfi" campaign "$work"/bench.yaml --arm --out "$work"/bench2 --resume --quiet --no-vcd > "$work"/bench3.txt || test $? -eq 1
+cat "$work"/bench3.txt
+verdicts "$work"/bench3.txt | tee "$work"/bench3.v
+diff "$work"/offline.v "$work"/bench3.v
+
 kill -INT $server
 wait $server || true
 server=
 cat "$work"/server.log
 grep -q "plant steps" "$work"/server.log
-echo "same verdicts offline and over Modbus"
+echo "same verdicts offline and over Modbus; interrupted and resumed"

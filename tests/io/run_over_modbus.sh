@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The stamping program on `plcfi plant-server` over Modbus TCP in real time: workpieces
-# get stamped; SIGTERM ends the run with the configured safe state on the coils; a server
-# killed mid-run is detected as lost communication, without a hang.
+# get stamped; every way out (normal end, SIGINT, SIGTERM, a VM trap) leaves the configured
+# safe state on the coils; a server killed and restarted mid-run is reconnected; a server
+# gone for longer than lost_after is lost communication: a safe stop, without a hang.
 # usage: run_over_modbus.sh PLCFI SOURCE_DIR
 set -euo pipefail
 plcfi=$1
@@ -18,6 +19,8 @@ start_server() {  # -> port in $port, pid in $server
   sed "s/127.0.0.1:1502/127.0.0.1:$port/" "$src"/st_programs/stamping/io_plant_server.yaml > "$work/io_$port.yaml"
 }
 program=$src/st_programs/stamping/stamping.st
+coils() { mbpoll -m tcp -a 1 -t 0 -r 1 -c 7 -1 -p "$port" 127.0.0.1 | sed -n 's/^\[\([0-9]*\)\]:[[:space:]]*\([01]\)$/\2/p' | tr -d '\n'; }
+safe=1000000   # SliderExtend kept on (safe_state), everything else off
 
 echo "== 1. twelve seconds of production over Modbus TCP"
 start_server
@@ -26,23 +29,60 @@ grep -q "ended: done; outputs written to the safe state" "$work/run1.txt"
 grep -q "device stamping: [0-9]* requests, 0 failed, 1 connect(s)" "$work/run1.txt"
 pieces=$(sed -n 's/^Main.pieceCount = //p' "$work/run1.txt")
 (( pieces >= 1 ))
+echo "coils after the end: $(coils)"
+[[ "$(coils)" == "$safe" ]]
 kill -INT $server; wait $server || true
 cat "$work/server_$port.log"
 grep -q "collisions 0" "$work/server_$port.log"
 
-echo "== 2. SIGTERM: the safe state reaches the plant"
+for sig in TERM INT; do
+  echo "== 2. SIG$sig: the safe state reaches the plant"
+  start_server
+  "$plcfi" run "$program" --io "$work/io_$port.yaml" --realtime --duration 60s > "$work/run2.txt" 2>&1 &
+  run=$!
+  pids+=($run)
+  moving=0   # production: within a few seconds the coils leave the safe state
+  for _ in $(seq 1 40); do sleep 0.2; [[ "$(coils)" != "$safe" ]] && { moving=1; break; }; done
+  (( moving ))
+  sleep 1
+  kill -$sig $run
+  wait $run
+  cat "$work/run2.txt"
+  grep -q "ended: SIG$sig; outputs written to the safe state (all off but 1)" "$work/run2.txt"
+  echo "coils after SIG$sig: $(coils)"
+  [[ "$(coils)" == "$safe" ]]
+  kill -INT $server; wait $server || true
+done
+
+echo "== 2b. a VM trap: the safe state reaches the plant"
 start_server
-"$plcfi" run "$program" --io "$work/io_$port.yaml" --realtime --duration 60s > "$work/run2.txt" 2>&1 &
+status=0
+"$plcfi" run "$src/tests/io/trap_after_2s.st" --cycle-time 10ms --io "$work/io_$port.yaml" --realtime --duration 30s \
+  > "$work/run2b.txt" 2>&1 || status=$?
+cat "$work/run2b.txt"
+(( status == 1 ))
+grep -q "ended: trap: .*division by zero" "$work/run2b.txt"
+echo "coils after the trap: $(coils)"
+[[ "$(coils)" == "$safe" ]]
+kill -INT $server; wait $server || true
+
+echo "== 2c. the server killed and restarted mid-run: reconnected, the run goes on"
+start_server
+sed -i 's/lost_after: 1s/lost_after: 20s/' "$work/io_$port.yaml"
+"$plcfi" run "$program" --io "$work/io_$port.yaml" --realtime --duration 8s > "$work/run2c.txt" 2>&1 &
 run=$!
 pids+=($run)
-sleep 4
-kill -TERM $run
+sleep 2
+kill -9 $server; wait $server 2>/dev/null || true
+sleep 2
+"$plcfi" plant-server --listen 127.0.0.1:$port --duration 120s > "$work/server2_$port.log" 2>&1 &
+server=$!
+pids+=($server)
 wait $run
-cat "$work/run2.txt"
-grep -q "ended: SIGTERM; outputs written to the safe state (all off but 1)" "$work/run2.txt"
-coils=$(mbpoll -m tcp -a 1 -t 0 -r 1 -c 7 -1 -p "$port" 127.0.0.1 | sed -n 's/^\[\([0-9]*\)\]:[[:space:]]*\([01]\)$/\2/p' | tr -d '\n')
-echo "coils after SIGTERM: $coils"
-[[ "$coils" == "1000000" ]]   # SliderExtend kept on (safe_state), everything else off
+cat "$work/run2c.txt"
+grep -q "ended: done" "$work/run2c.txt"
+grep -q "device stamping: [0-9]* requests, [1-9][0-9]* failed, 2 connect(s), 1 disconnect(s)" "$work/run2c.txt"
+[[ "$(coils)" == "$safe" ]]
 kill -INT $server; wait $server || true
 
 echo "== 3. the server dies mid-run: lost communication, safe stop, no hang"
