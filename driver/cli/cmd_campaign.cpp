@@ -210,7 +210,7 @@ int cmd_generate(const std::vector<std::string>& args) {
 int cmd_campaign(const std::vector<std::string>& args) {
   const std::string usage =
       "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--seed N] [--no-vcd] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]]";
-  po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time)");
+  po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
   desc.add_options()
       ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
       ("resume", "finish a campaign whose journal is in the output folder (no case runs twice)")

@@ -92,7 +92,8 @@ class ModbusIo : public ::testing::Test {
     IoConfig cfg;
     std::string err;
     EXPECT_TRUE(load_io_config(temp("plcfi_io", text), *b_->app, &cfg, &err)) << err;
-    auto mb = ModbusBackend::create(cfg, 10'000'000, &err);
+    // A 1 s cycle: these tests scan on their own clock and allow the devices 200 ms.
+    auto mb = ModbusBackend::create(cfg, 1'000'000'000, &err);
     EXPECT_TRUE(mb) << err;
     return mb;
   }
@@ -234,6 +235,16 @@ class LibmodbusServer {
   std::thread thread_;
   std::atomic<bool> stop_{false};
 };
+
+TEST_F(ModbusIo, TimeoutMustBeBelowTheCycle) {
+  IoConfig cfg;
+  std::string err;
+  std::string path = temp("plcfi_io_timeout", io_text("tcp: \"127.0.0.1:1502\""));
+  ASSERT_TRUE(load_io_config(path, *b_->app, &cfg, &err)) << err;
+  EXPECT_EQ(ModbusBackend::create(cfg, 100'000'000, &err), nullptr);  // 200 ms timeout, 100 ms cycle
+  EXPECT_EQ(err, path + ":3:7: device 'unit1': timeout 200 ms is not below the cycle time 100 ms (a silent device would "
+                        "make every scan overrun)");
+}
 
 TEST_F(ModbusIo, ExchangesTheImageInTheScan) {
   int port = free_port();

@@ -31,7 +31,15 @@ int max_count(ModbusTable t, bool write) {
 std::unique_ptr<ModbusBackend> ModbusBackend::create(const IoConfig& cfg, int64_t cycle_ns, std::string* err) {
   std::unique_ptr<ModbusBackend> b(new ModbusBackend());
   b->cfg_ = cfg;
-  b->timeout_default_ = std::max<int64_t>(cycle_ns / 2, 1'000'000);
+  b->timeout_default_ = std::max<int64_t>(cycle_ns / 2, 100'000);
+  // A device that does not answer must not stretch the scan past its deadline.
+  for (const auto& d : cfg.devices)
+    if (d.timeout_ns >= cycle_ns) {
+      *err = fmt::format("{}: device '{}': timeout {} ms is not below the cycle time {} ms (a silent device would make "
+                         "every scan overrun)",
+                         d.where, d.name, static_cast<double>(d.timeout_ns) / 1e6, static_cast<double>(cycle_ns) / 1e6);
+      return nullptr;
+    }
   b->dev_.resize(cfg.devices.size());
   b->stats_.resize(cfg.devices.size());
   // Points grouped by device, table and direction, merged into contiguous blocks.
