@@ -1160,8 +1160,8 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
       kind = k;
     }
   if (!is_test_builtin) return std::nullopt;
-  if (!opt_.test_mode) {
-    diags_.error("ST211", c.loc, name + " is only available in test files");
+  if (!b_->in_test) {
+    diags_.error("ST211", c.loc, name + " is only available in TEST, SETUP and TEARDOWN blocks of test files");
     return bad();
   }
   Val none;

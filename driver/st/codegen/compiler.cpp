@@ -452,6 +452,7 @@ void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
   b_->file = tf.file;
   b_->vars_end = p->frame_size;
   b_->this_type = p->type;
+  b_->in_test = true;
   for (const auto& v : p->vars) b_->locals[canon(v->name)] = v.get();
   std::vector<uint32_t> entries;
   const StmtList* parts[3] = {tf.setup ? &tf.setup->body : nullptr, &tc.body, tf.teardown ? &tf.teardown->body : nullptr};

@@ -119,6 +119,7 @@ struct Body {
   std::map<std::tuple<uint32_t, SK, Storage, Storage>, Slot> cvt_cache;
   std::unordered_map<std::string, Symbol*> locals;  // canon name -> symbol (frame or This)
   bool is_method = false;
+  bool in_test = false;             // a TEST/SETUP/TEARDOWN body: asserts and mocks allowed
   const Type* this_type = nullptr;  // FB type whose members are reachable (body or method)
   struct Loop {
     Label exit, cont;

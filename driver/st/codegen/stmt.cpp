@@ -118,8 +118,8 @@ void Compiler::stmt(const Stmt& s) {
     case StmtKind::Empty: break;
     case StmtKind::Mock: {
       const auto& m = static_cast<const MockStmt&>(s);
-      if (!opt_.test_mode) {
-        diags_.error("ST234", s.loc, "MOCK is only allowed in test files");
+      if (!b_->in_test) {
+        diags_.error("ST234", s.loc, "MOCK is only allowed in TEST, SETUP and TEARDOWN blocks of test files");
         break;
       }
       Place p = place(*m.target, false);
@@ -134,8 +134,8 @@ void Compiler::stmt(const Stmt& s) {
     case StmtKind::MockFunction: {
       b_->cvt_cache.clear();
       const auto& m = static_cast<const MockFunctionStmt&>(s);
-      if (!opt_.test_mode) {
-        diags_.error("ST234", s.loc, "MOCK_FUNCTION is only allowed in test files");
+      if (!b_->in_test) {
+        diags_.error("ST234", s.loc, "MOCK_FUNCTION is only allowed in TEST, SETUP and TEARDOWN blocks of test files");
         break;
       }
       auto it = pous_.find(canon(m.function.text));
