@@ -53,6 +53,26 @@ void ImageRef::set(uint8_t* base, int64_t v) const {
   }
 }
 
+namespace {
+
+// The type of the variable the program declares AT exactly this address and size
+// (`StampPressure AT %IW2 : INT`), so an address reads and clamps like the program's
+// variable and not like the bare WORD the address names. nullptr: none declared there.
+const st::Type* declared_type_at(const st::Application& app, uint32_t addr, uint32_t size) {
+  auto match = [&](const st::Symbol& s) {
+    return s.kind == st::SymKind::Var && s.where == st::Where::Abs && s.offset == addr && s.type &&
+           s.type->is_elementary() && s.type->size == size;
+  };
+  for (const auto& g : app.globals)
+    if (g.sym && match(*g.sym)) return g.sym->type;
+  for (const auto& inst : app.programs)
+    for (const auto& v : inst.pou->vars)
+      if (match(*v)) return v->type;
+  return nullptr;
+}
+
+}  // namespace
+
 bool parse_image_ref(const st::Application& app, const std::string& text, ImageRef* ref, std::string* err) {
   auto h = st::resolve(app, text, err);
   if (!h) return false;
@@ -65,6 +85,8 @@ bool parse_image_ref(const st::Application& app, const std::string& text, ImageR
       ref->bit = h->bit;
       ref->size = static_cast<uint8_t>(h->is_bit ? 1 : h->type->size);
       ref->type = h->type;
+      if (!h->is_bit && !text.empty() && text[0] == '%')
+        if (const st::Type* t = declared_type_at(app, h->addr, h->type->size)) ref->type = t;
       ref->text = text;
       if (!h->is_bit && !h->type->is_elementary()) {
         *err = "'" + text + "' is not an elementary value in the I/O image";

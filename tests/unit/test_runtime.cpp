@@ -148,6 +148,30 @@ TEST(Runtime, OutputOverlayChangesWhatThePlantReceivesNotTheProgramVariable) {
   EXPECT_EQ(0, fb.last_out & 1);                    // the plant got FALSE
 }
 
+TEST(Runtime, ImageRefByAddressTakesTheDeclaredVariablesType) {
+  auto b = build(R"(
+PROGRAM P
+VAR
+  pressure AT %IW2 : INT;
+  raw AT %IW4 : WORD;
+  y AT %QW0 : INT;
+END_VAR
+y := pressure;
+END_PROGRAM
+)");
+  ImageRef ref;
+  std::string err;
+  ASSERT_TRUE(parse_image_ref(*b->app, "%IW2", &ref, &err)) << err;
+  EXPECT_EQ(ref.type->name, "INT");  // as the program declares it: signed, clamps at -32768..32767
+  uint8_t area[8] = {};
+  ref.set(area, -5);
+  EXPECT_EQ(ref.get(area), -5);
+  ASSERT_TRUE(parse_image_ref(*b->app, "%IW4", &ref, &err)) << err;
+  EXPECT_EQ(ref.type->name, "WORD");
+  ASSERT_TRUE(parse_image_ref(*b->app, "%IW6", &ref, &err)) << err;  // nothing declared there: what the address names
+  EXPECT_EQ(ref.type->name, "WORD");
+}
+
 TEST(Runtime, ImageRefRejectsAddressesOutsideTheIoAreas) {
   auto b = build(kEcho);
   ImageRef ref;
