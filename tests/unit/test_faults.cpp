@@ -213,8 +213,8 @@ TEST_F(FaultFixture, StuckAtFrozenOpenWire) {
   inject("open_wire(-32768)", "P.p");  // through the INT the program declared there
   EXPECT_EQ(scan_word(10), -32768);
   rt_->input_overlay().clear();
-  inject("open_wire(-32768)", "%IW2");  // the bare address is a WORD: 0..65535
-  EXPECT_EQ(scan_word(10), 0);
+  inject("open_wire(-32768)", "%IW2");  // the address takes the INT declared AT it
+  EXPECT_EQ(scan_word(10), -32768);
   rt_->input_overlay().clear();
   plant_.bit = true;
   inject("open_wire", "%IX0.0");
