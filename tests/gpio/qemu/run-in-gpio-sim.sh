@@ -37,6 +37,22 @@ tmp_dirs=()
 # shellcheck disable=SC2317  # called from the trap
 cleanup() { if [[ ${#tmp_dirs[@]} -gt 0 ]]; then rm -rf "${tmp_dirs[@]}"; fi; }
 trap cleanup EXIT
+# On INT/TERM/HUP: stop the guest (qemu_pid_file, once it runs), then exit 1 through
+# the EXIT trap. Without these traps bash would die without cleaning up, leaving qemu.
+qemu_pid_file=
+# shellcheck disable=SC2317  # called from the traps
+on_signal() {
+  trap - INT TERM HUP
+  if [[ -n $qemu_pid_file && -s $qemu_pid_file ]]; then
+    kill -TERM "$(<"$qemu_pid_file")" 2>/dev/null || true
+    wait 2>/dev/null || true
+  fi
+  echo "$PROG: ERROR: interrupted by SIG$1" >&2
+  exit 1
+}
+trap 'on_signal INT' INT
+trap 'on_signal TERM' TERM
+trap 'on_signal HUP' HUP
 
 # ---------------------------------------------------------------- host tools
 command -v qemu-system-x86_64 >/dev/null 2>&1 ||
@@ -238,6 +254,7 @@ if ! cache_complete; then
   exec 9>"$cache_root/$abi.lock"
   flock -w 1200 9 || fail "timed out waiting for the cache lock $cache_root/$abi.lock"
   if ! cache_complete; then
+    rm -rf "$cache_root/.prepare-$abi."*   # left by a preparer that was killed
     start=$SECONDS
     note "preparing kernel $kver with gpio-sim in $cache (once per kernel version)"
     prepare_cache
@@ -309,7 +326,7 @@ shq() { local s=${1//\'/\'\\\'\'}; printf "'%s'" "$s"; }
   done
 } >"$root/args.sh"
 
-# A per-run token marks the guest's report line, so no test output can forge it.
+# A per-run token marks the guest's report line, so no test output is taken for it.
 token=$(od -An -N8 -tx8 /dev/urandom | tr -d ' \n')
 
 cat >"$root/init" <<EOF
@@ -380,19 +397,35 @@ chmod 0755 "$root/init"
 # whose banner and terminal resets would otherwise come first on stdout.
 firmware=()
 if [[ -f /usr/share/qemu/qboot.rom ]]; then firmware=(-bios /usr/share/qemu/qboot.rom); fi
-set +e
-timeout -k 10 "$qemu_timeout" qemu-system-x86_64 -accel tcg -m 512 -smp 1 -nographic -no-reboot \
-  -nic none "${firmware[@]}" -device isa-debug-exit,iobase=0xf4,iosize=0x04 \
-  -kernel "$cache/vmlinuz" -initrd "$work/initrd.cpio" \
-  -append "console=ttyS0 quiet loglevel=3 panic=-1" </dev/null | tee "$work/console.log"
-status=${PIPESTATUS[0]}
-set -e
+#
+# --foreground keeps qemu in this script's process group, so a Ctrl-C or a signal to
+# the group reaches it. The pipeline runs in the background and is waited for with
+# `wait`, so that the signal traps run at once rather than after qemu ends.
+qemu_pid_file=$work/qemu.pid
+{
+  timeout --foreground -k 10 "$qemu_timeout" qemu-system-x86_64 -accel tcg -m 512 -smp 1 \
+    -nographic -no-reboot -nic none "${firmware[@]}" \
+    -device isa-debug-exit,iobase=0xf4,iosize=0x04 \
+    -kernel "$cache/vmlinuz" -initrd "$work/initrd.cpio" \
+    -append "console=ttyS0 quiet loglevel=3 panic=-1" </dev/null &
+  echo $! >"$qemu_pid_file"
+  rc=0
+  wait $! || rc=$?
+  echo "$rc" >"$work/qemu.status"
+} | tee "$work/console.log" &
+wait $! || true
+[[ -s $work/qemu.status ]] || fail "qemu's exit status got lost"
+status=$(<"$work/qemu.status")
 
+# Not anchored at the line start: a test's last line may lack its newline.
 reported=$(tr -d '\r' <"$work/console.log" |
-  sed -n "s/^plcfi-gpio-qemu\[$token\]: test exit status \([0-9][0-9]*\)\$/\1/p" | tail -n1)
+  sed -n "s/^.*plcfi-gpio-qemu\[$token\]: test exit status \([0-9][0-9]*\)\$/\1/p" | tail -n1)
 
-if [[ $status -eq 124 || $status -eq 137 ]]; then
+if [[ $status -eq 124 ]]; then
   fail "the guest did not finish within ${qemu_timeout} s (timeout; see the console output above)"
+fi
+if [[ $status -eq 137 ]]; then
+  fail "qemu was killed (SIGKILL: after ignoring the timeout's SIGTERM, or from outside)"
 fi
 if [[ -n $reported ]]; then
   # The report line and qemu's status must agree: (rc << 1) | 1, cut to 8 bits.
