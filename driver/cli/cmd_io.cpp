@@ -89,6 +89,7 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
     }
   }
   rt::Runtime runtime(app, sched, backend.get());
+  runtime.machine().set_native(o.native);
   runtime.set_safe_state(cfg.safe_state);
   runtime.cold_restart(1);
   if (!setup(runtime.machine())) {

@@ -126,7 +126,8 @@ int cmd_sim(const std::vector<std::string>& args) {
       ("csv", po::value<std::string>(), "write a CSV trace (one row per scan)")
       ("watch", po::value<std::vector<std::string>>(), "variables to trace, comma-separated (default: the plant's signals and the alarms)")
       ("alarms", po::value<std::vector<std::string>>(), "alarm variables to report (default: BOOL globals named *Error*, *Alarm*, *Warning*, *Stop*, *Fault*)")
-      ("requirements", po::value<std::string>(), "EDTL requirements (YAML) checked every scan");
+      ("requirements", po::value<std::string>(), "EDTL requirements (YAML) checked every scan")
+      ("native", "run the program (and the monitors) through the native tier");
   desc.add_options()("help,h", "show this help");
   po::options_description all;
   all.add(desc);
@@ -196,6 +197,9 @@ int cmd_sim(const std::vector<std::string>& args) {
     return 2;
   }
   rt::Runtime runtime(app, sched, backend.get());
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(app, "plcfi sim"))) return 2;
+  runtime.machine().set_native(native.get());
 
   // Alarm variables.
   std::vector<st::VarHandle> alarms;

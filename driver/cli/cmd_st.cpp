@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "native/native.hpp"
 #include "json.hpp"
 #include "engine.hpp"
 #include "report/junit.hpp"
@@ -68,6 +69,19 @@ std::string json_value(const st::Machine& m, const st::VarHandle& h) {
 
 }  // namespace
 
+std::unique_ptr<st::NativeCode> load_native(const st::Application& app, const char* who) {
+  std::string err;
+  auto nc = st::NativeCode::build(app, st::NativeOptions{}, &err);
+  if (!nc) {
+    std::cerr << who << ": " << err << "\n";
+    return nullptr;
+  }
+  std::cerr << fmt::format("{}: native tier: {} function(s){}, {}\n", who, nc->functions(),
+                           nc->interpreted() ? fmt::format(", {} left to the interpreter", nc->interpreted()) : "",
+                           nc->from_cache() ? "from the cache" : fmt::format("compiled in {:.2f} s", nc->compile_seconds()));
+  return nc;
+}
+
 int cmd_check(const std::vector<std::string>& args) {
   po::options_description desc("plcfi check: compile ST files and report every error and warning");
   desc.add_options()("no-warnings", "report errors only");
@@ -86,12 +100,19 @@ int cmd_check(const std::vector<std::string>& args) {
 
 int cmd_disasm(const std::vector<std::string>& args) {
   po::options_description desc("plcfi disasm: print the bytecode of ST files with their source lines");
+  desc.add_options()("native", "print the C++ the native tier generates instead");
   po::variables_map vm;
-  if (!parse(args, desc, vm, "plcfi disasm FILES...")) return 0;
+  if (!parse(args, desc, vm, "plcfi disasm FILES... [--native]")) return 0;
   st::CompileOptions opt;
   opt.warnings = false;
   auto b = load(files_of(vm), opt, "disasm");
   if (!b || !b->ok()) return 2;
+  if (vm.count("native")) {
+    std::vector<uint32_t> entries, skipped;
+    std::cout << st::native_source(*b->app, &entries, &skipped);
+    for (uint32_t e : skipped) std::cout << "// left to the interpreter: entry " << e << "\n";
+    return 0;
+  }
   std::cout << st::disassemble(*b->app, b.get());
   return 0;
 }
@@ -107,6 +128,7 @@ int cmd_run(const std::vector<std::string>& args) {
       ("json", "print the result as JSON")
       ("coverage", "print branch coverage per file")
       ("budget", po::value<uint64_t>()->default_value(10'000'000), "loop iterations allowed per program call (watchdog)")
+      ("native", "run the program through the native tier (generated C++, compiled by the system's compiler)")
       ("io", po::value<std::string>(), "exchange the image with real I/O (a file with an io: section: Modbus devices and mappings)")
       ("realtime", "pace the scans on absolute real-time deadlines and report wake latency (with or without --io)")
       ("duration", po::value<std::string>(), "with --io or --realtime: run this long (e.g. 10s); SIGINT/SIGTERM also end the run")
@@ -138,8 +160,11 @@ int cmd_run(const std::vector<std::string>& args) {
     std::cerr << "plcfi run: " << err << "\n";
     return 2;
   }
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(app, "plcfi run"))) return 2;
   if (vm.count("io") || vm.count("realtime")) {
     RunIoOptions o;
+    o.native = native.get();
     o.realtime = vm.count("realtime") > 0;
     o.rt.priority = vm["rt-priority"].as<int>();
     o.rt.cpu = vm["cpu"].as<int>();
@@ -182,6 +207,7 @@ int cmd_run(const std::vector<std::string>& args) {
   }
   st::Machine m(app);
   m.set_budget(vm["budget"].as<uint64_t>());
+  m.set_native(native.get());
   if (vm.count("set")) {
     for (const auto& s : vm["set"].as<std::vector<std::string>>()) {
       auto eq = s.find('=');
@@ -247,7 +273,8 @@ int cmd_test(const std::vector<std::string>& args) {
   desc.add_options()
       ("junit", po::value<std::string>(), "write JUnit XML to this file")
       ("coverage", "print branch coverage of the sources")
-      ("budget", po::value<uint64_t>()->default_value(100'000'000), "loop iterations allowed per test phase (watchdog)");
+      ("budget", po::value<uint64_t>()->default_value(100'000'000), "loop iterations allowed per test phase (watchdog)")
+      ("native", "run the tests through the native tier (generated C++, compiled by the system's compiler)");
   po::variables_map vm;
   if (!parse(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage]")) return 0;
   st::CompileOptions opt;
@@ -260,6 +287,9 @@ int cmd_test(const std::vector<std::string>& args) {
     return 2;
   }
   st::Machine m(*b->app);
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(*b->app, "plcfi test"))) return 2;
+  m.set_native(native.get());
   st::TestRunOptions ro;
   ro.budget = vm["budget"].as<uint64_t>();
   auto results = st::run_tests(*b->app, m, ro);

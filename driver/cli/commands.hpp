@@ -3,11 +3,13 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "runtime/schedule.hpp"
 #include "vm/program.hpp"
+#include "native/native.hpp"
 #include "vm/vm.hpp"
 
 namespace plcfi::cli {
@@ -21,6 +23,10 @@ int cmd_edtl(const std::vector<std::string>& args);
 int cmd_generate(const std::vector<std::string>& args);
 int cmd_campaign(const std::vector<std::string>& args);
 int cmd_plant_server(const std::vector<std::string>& args);
+
+// --native: the application's native tier, built (or found in the cache) and reported
+// on stderr as `who: native tier: ...`; nullptr after printing the error.
+std::unique_ptr<st::NativeCode> load_native(const st::Application& app, const char* who);
 
 // `plcfi run --io`: the program on real I/O (Modbus), optionally paced in real time.
 struct RealtimeOptions {
@@ -38,6 +44,7 @@ struct RunIoOptions {
   bool realtime = false;
   RealtimeOptions rt;
   std::string junit;        // JUnit XML with the real-time figures as properties ("": none)
+  const st::NativeCode* native = nullptr;
 };
 // setup() runs once after the cold restart (--set); report() at the end (--print).
 int run_with_io(const st::Application& app, const rt::Schedule& sched, const std::string& io_path, const RunIoOptions& o,

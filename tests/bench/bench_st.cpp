@@ -16,6 +16,9 @@
 //
 // `plcfi_bench --disasm=<kernel>` prints the kernel's bytecode instead (for profiling).
 #include <benchmark/benchmark.h>
+#include <cstring>
+
+#include "native/native.hpp"
 
 #include <algorithm>
 #include <cinttypes>
@@ -68,6 +71,7 @@ struct VmKernel {
   std::unique_ptr<st::Build> build;
   uint32_t entry = 0, addr = 0;
   st::VarHandle result;
+  std::unique_ptr<st::NativeCode> native;  // the native tier (built on first use)
 };
 
 VmKernel compile_kernel(const std::string& name) {
@@ -102,6 +106,18 @@ const VmKernel& kernel(const std::string& name) {
   return it->second;
 }
 
+// The kernel's native tier: generated C++, compiled by the system compiler, cached.
+const st::NativeCode& native_tier(const std::string& name) {
+  VmKernel& k = const_cast<VmKernel&>(kernel(name));
+  if (!k.native) {
+    std::string err;
+    k.native = st::NativeCode::build(*k.build->app, st::NativeOptions{}, &err);
+    if (!k.native) die("kernel " + name + ": " + err);
+    if (k.native->interpreted() != 0) die("kernel " + name + ": the native tier left code to the interpreter");
+  }
+  return *k.native;
+}
+
 // One scan at `now`. Returns false (after reporting) on a trap.
 inline bool vm_scan(st::Machine& m, const VmKernel& k, int64_t now) {
   m.set_now(now);
@@ -133,6 +149,7 @@ using FbCallsK = Native<nb::FbCallsState, nb::fb_calls_scan>;
 void run_vm(benchmark::State& state, const char* name) {
   const VmKernel& k = kernel(name);
   st::Machine m(*k.build->app);
+  if (state.range(0) == 1) m.set_native(&native_tier(name));
   int64_t now = 0;
   int scans = 0;
   for (auto _ : state) {
@@ -193,11 +210,17 @@ template <class K>
 void check_kernel(const Expect& e) {
   const VmKernel& k = kernel(e.name);
   st::Machine m(*k.build->app);
+  st::Machine tier(*k.build->app);
+  tier.set_native(&native_tier(e.name));
   int64_t now = 0;
   for (int i = 0; i < kCheckScans; ++i) {
     if (!vm_scan(m, k, now)) die_trap(k, m, i);
+    if (!vm_scan(tier, k, now)) die_trap(k, tier, i);
     now += kScanNs;
   }
+  // The native tier leaves memory and coverage exactly as the interpreter does.
+  if (std::memcmp(m.mem(), tier.mem(), m.mem_size()) != 0 || m.taken() != tier.taken())
+    die("kernel " + std::string(e.name) + ": the native tier's memory after 100 scans differs from the interpreter's");
   auto s = native_after<K>(kCheckScans);
   if (!e.is_real) {
     int64_t vm = st::read_int(m, k.result);
@@ -436,15 +459,20 @@ void print_table(const CollectingReporter& rep) {
   bool any = false;
   for (const char* n : kNames) {
     double vm = rep.ns(std::string("BM_") + n + "_vm"), nat = rep.ns(std::string("BM_") + n + "_native");
-    if (vm == 0 && nat == 0) continue;
+    double tier = rep.ns(std::string("BM_") + n + "_tier");
+    if (vm == 0 && nat == 0 && tier == 0) continue;
     if (!any) {
-      std::printf("\nST VM vs native C++ (CPU time per scan; target: VM <= 5x native)\n");
-      std::printf("%-14s %14s %14s %10s\n", "kernel", "VM ns/scan", "native ns/scan", "VM/native");
+      std::printf("\nST engine vs native C++ (CPU time per scan; target: engine <= 5x native)\n");
+      std::printf("%-14s %14s %14s %14s %10s %11s\n", "kernel", "interp ns", "tier ns", "native ns", "interp/nat",
+                  "tier/nat");
       any = true;
     }
-    char ratio[32] = "-";
-    if (vm > 0 && nat > 0) std::snprintf(ratio, sizeof ratio, "%.2fx%s", vm / nat, vm / nat > 5.0 ? " !" : "");
-    std::printf("%-14s %14.1f %14.1f %10s\n", n, vm, nat, ratio);
+    auto ratio = [&](double x) {
+      char buf[32] = "-";
+      if (x > 0 && nat > 0) std::snprintf(buf, sizeof buf, "%.2fx%s", x / nat, x / nat > 5.0 ? " !" : "");
+      return std::string(buf);
+    };
+    std::printf("%-14s %14.1f %14.1f %14.1f %10s %11s\n", n, vm, tier, nat, ratio(vm).c_str(), ratio(tier).c_str());
   }
   double parse = rep.ns("BM_parse_check_10k_lines");
   if (parse > 0) {
@@ -459,15 +487,20 @@ void print_table(const CollectingReporter& rep) {
 
 }  // namespace
 
-BENCHMARK_CAPTURE(run_vm, state_machine, "state_machine")->Name("BM_state_machine_vm");
+BENCHMARK_CAPTURE(run_vm, state_machine, "state_machine")->Name("BM_state_machine_vm")->Arg(0);
+BENCHMARK_CAPTURE(run_vm, state_machine_tier, "state_machine")->Name("BM_state_machine_tier")->Arg(1);
 BENCHMARK(run_native<StateMachineK>)->Name("BM_state_machine_native");
-BENCHMARK_CAPTURE(run_vm, int_loop, "int_loop")->Name("BM_int_loop_vm");
+BENCHMARK_CAPTURE(run_vm, int_loop, "int_loop")->Name("BM_int_loop_vm")->Arg(0);
+BENCHMARK_CAPTURE(run_vm, int_loop_tier, "int_loop")->Name("BM_int_loop_tier")->Arg(1);
 BENCHMARK(run_native<IntLoopK>)->Name("BM_int_loop_native");
-BENCHMARK_CAPTURE(run_vm, real_math, "real_math")->Name("BM_real_math_vm");
+BENCHMARK_CAPTURE(run_vm, real_math, "real_math")->Name("BM_real_math_vm")->Arg(0);
+BENCHMARK_CAPTURE(run_vm, real_math_tier, "real_math")->Name("BM_real_math_tier")->Arg(1);
 BENCHMARK(run_native<RealMathK>)->Name("BM_real_math_native");
-BENCHMARK_CAPTURE(run_vm, array_struct, "array_struct")->Name("BM_array_struct_vm");
+BENCHMARK_CAPTURE(run_vm, array_struct, "array_struct")->Name("BM_array_struct_vm")->Arg(0);
+BENCHMARK_CAPTURE(run_vm, array_struct_tier, "array_struct")->Name("BM_array_struct_tier")->Arg(1);
 BENCHMARK(run_native<ArrayStructK>)->Name("BM_array_struct_native");
-BENCHMARK_CAPTURE(run_vm, fb_calls, "fb_calls")->Name("BM_fb_calls_vm");
+BENCHMARK_CAPTURE(run_vm, fb_calls, "fb_calls")->Name("BM_fb_calls_vm")->Arg(0);
+BENCHMARK_CAPTURE(run_vm, fb_calls_tier, "fb_calls")->Name("BM_fb_calls_tier")->Arg(1);
 BENCHMARK(run_native<FbCallsK>)->Name("BM_fb_calls_native");
 BENCHMARK(BM_parse_check_10k_lines)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_build_stdlib_only)->Unit(benchmark::kMillisecond);

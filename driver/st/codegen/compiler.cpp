@@ -360,6 +360,8 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   uint32_t frame_size = align_up(temp_base + b.temp_max, 8);
   for (auto [idx, kind] : b.slot_fix) b.code[idx] += kind == SK::Const ? const_base : kind == SK::Hidden ? hidden_base : temp_base;
   p->frame_size = frame_size;
+  p->const_from = const_base;
+  p->consts = b.consts;
   // Monitors: where the state shift works, so a caller can do it natively (StateShift).
   if (p->late && p->kind == PouKind::Program && b.state_seen) {
     auto at = [&](Slot sl) { return sl.off + (sl.kind == SK::Hidden ? hidden_base : 0); };
@@ -422,6 +424,8 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   for (auto [idx, pou] : b.entry_fix) entry_fix_.emplace_back(base + idx, pou);
   for (auto [pc, loc] : b.lines) app_->lines.emplace_back(base + pc, loc);
   app_->code.insert(app_->code.end(), b.code.begin(), b.code.end());
+  p->code_begin = base;
+  p->code_end = static_cast<uint32_t>(app_->code.size());
   if (entries)
     for (auto& e : *entries) e += base;
 }

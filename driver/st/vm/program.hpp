@@ -93,6 +93,11 @@ struct PouInfo {
   uint32_t tmpl_from = 0, tmpl_to = 0;  // frame part (re)initialized per call, from a template
   uint32_t template_addr = 0;           // absolute address of that template
   uint32_t entry = 0;       // code index of the body
+  uint32_t code_begin = 0, code_end = 0;  // the body's range in the code
+  // The frame's constant pool [const_from, const_from + consts.size()): read-only slots
+  // holding literals (the native tier folds them into its code).
+  uint32_t const_from = 0;
+  std::vector<uint8_t> consts;
   uint32_t selector = 0;    // METHOD: global selector for dynamic dispatch
   uint32_t mock_addr = 0;   // FUNCTION in test builds: {flag, pad, value} block
   bool declared = false;    // signature and variable layout done

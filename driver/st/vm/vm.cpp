@@ -1,6 +1,8 @@
 // The VM's dispatch loop (computed goto over opcodes.def) and its trap handling.
 #include "memory.hpp"
+#include "ops.hpp"
 #include "vm.hpp"
+#include "native/native.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -11,6 +13,8 @@
 
 namespace plcfi::st {
 
+using namespace ops;  // NOLINT: the instruction semantics
+
 namespace {
 constexpr OpInfo kOps[] = {
 #define OP(name, nargs, rtl) {#name, nargs, rtl},
@@ -18,101 +22,6 @@ constexpr OpInfo kOps[] = {
 #undef OP
 };
 
-__extension__ typedef unsigned __int128 U128;  // one MUL on x86-64 and AArch64
-
-template <class T>
-inline T ld(const uint8_t* p) {
-  return load_as<T>(p);
-}
-template <class T>
-inline void st(uint8_t* p, T v) {
-  store_as<T>(p, v);
-}
-
-// Two's-complement wraparound without undefined behaviour (IEC integer overflow wraps).
-template <class T>
-using Wide = std::conditional_t<(sizeof(T) < 4), uint32_t, std::make_unsigned_t<T>>;
-template <class T>
-inline T wadd(T a, T b) {
-  if constexpr (std::is_floating_point_v<T>) return a + b;
-  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) +
-                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
-}
-template <class T>
-inline T wsub(T a, T b) {
-  if constexpr (std::is_floating_point_v<T>) return a - b;
-  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) -
-                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
-}
-template <class T>
-inline T wmul(T a, T b) {
-  if constexpr (std::is_floating_point_v<T>) return a * b;
-  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) *
-                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
-}
-template <class T>
-inline T wneg(T a) {
-  if constexpr (std::is_floating_point_v<T>) return -a;
-  else return wsub<T>(T(0), a);
-}
-template <class T>
-inline T wdiv(T a, T b) {  // b != 0 checked by the caller for integers
-  if constexpr (std::is_signed_v<T> && std::is_integral_v<T>) {
-    if (b == T(-1)) return wneg(a);
-  }
-  return static_cast<T>(a / b);
-}
-template <class T>
-inline T wmod(T a, T b) {
-  if constexpr (std::is_signed_v<T>) {
-    if (b == T(-1)) return T(0);
-  }
-  return static_cast<T>(a % b);
-}
-template <class T>
-inline T wabs(T a) {
-  if constexpr (std::is_floating_point_v<T>) return std::fabs(a);
-  else if constexpr (std::is_signed_v<T>) return a < 0 ? wneg(a) : a;
-  else return a;
-}
-// Conversions saturate where C++ would be undefined (float to integer out of range, NaN).
-template <class To, class From>
-inline To cvt(From v) {
-  if constexpr (std::is_integral_v<To> && std::is_floating_point_v<From>) {
-    if (std::isnan(v)) return To(0);
-    if (v <= static_cast<From>(std::numeric_limits<To>::min())) return std::numeric_limits<To>::min();
-    if (v >= static_cast<From>(std::numeric_limits<To>::max())) return std::numeric_limits<To>::max();
-    return static_cast<To>(v);
-  } else {
-    return static_cast<To>(v);
-  }
-}
-template <class T>
-inline T shl(T v, uint64_t n) {
-  using U = std::make_unsigned_t<T>;
-  if (n >= sizeof(T) * 8) return T(0);
-  return static_cast<T>(static_cast<U>(static_cast<Wide<T>>(static_cast<U>(v)) << n));
-}
-template <class T>
-inline T shr(T v, uint64_t n) {
-  using U = std::make_unsigned_t<T>;
-  if (n >= sizeof(T) * 8) return T(0);
-  return static_cast<T>(static_cast<U>(static_cast<U>(v) >> n));
-}
-template <class T>
-inline T rol(T v, uint64_t n) {
-  constexpr uint64_t w = sizeof(T) * 8;
-  n %= w;
-  if (n == 0) return v;
-  return static_cast<T>(shl(v, n) | shr(v, w - n));
-}
-template <class T>
-inline T ror(T v, uint64_t n) {
-  constexpr uint64_t w = sizeof(T) * 8;
-  n %= w;
-  if (n == 0) return v;
-  return static_cast<T>(shr(v, n) | shl(v, w - n));
-}
 }  // namespace
 
 const OpInfo& op_info(Op op) { return kOps[static_cast<uint32_t>(op)]; }
@@ -177,14 +86,97 @@ bool Machine::call(uint32_t entry, uint32_t base_addr) {
   trap_.kind = TrapKind::None;  // the message is only meaningful after a failed call
   if (entry >= app_->code.size() || base_addr > mem_.size())
     return fail(TrapKind::BadAddress, app_->code.data(), "entry or base outside the application");
-  return run(app_->code.data() + entry, mem_.data() + base_addr);
+  if (native_)
+    if (native_abi::Fn fn = native_->find(entry)) return call_native(reinterpret_cast<const void*>(fn), mem_.data() + base_addr);
+  int64_t budget = static_cast<int64_t>(budget_limit_);
+  return run(app_->code.data() + entry, mem_.data() + base_addr, app_->mstack_addr, &budget);
+}
+
+// ----------------------------------------------------------------- native tier
+
+struct NativeBridge {
+  static Machine& m(native_abi::Ctx* c) { return *static_cast<Machine*>(c->host); }
+
+  // The message of the trap, as the interpreter words it for the same instruction.
+  static int trap(native_abi::Ctx* c, uint32_t kind, uint32_t pc, int64_t a, int64_t b, int64_t cc) {
+    Machine& vm = m(c);
+    const uint32_t* w = vm.app_->code.data() + pc;
+    auto k = static_cast<TrapKind>(kind);
+    auto op = static_cast<Op>(w[0]);
+    std::string_view name = op_info(op).name;
+    std::string msg;
+    auto range = [&](int lo_at, int count_at) {
+      auto lo = static_cast<int32_t>(w[lo_at]);
+      return fmt::format("index {} outside {}..{}", a, lo, static_cast<int64_t>(lo) + w[count_at] - 1);
+    };
+    bool u64 = name.size() > 4 && name.substr(name.size() - 4) == "_U64";
+    auto num = [&](int64_t v) { return u64 ? std::to_string(static_cast<uint64_t>(v)) : std::to_string(v); };
+    if (op == Op::TRAP) {
+      msg = trap_name(k);
+    } else {
+      switch (k) {
+        case TrapKind::DivisionByZero: msg = a == 1 ? "MOD by zero" : "integer division by zero"; break;
+        case TrapKind::IndexOutOfRange:
+          if (name.rfind("CHK_", 0) == 0) msg = fmt::format("index {} outside {}..{}", num(a), num(b), num(cc));
+          else if (op == Op::ELEM || name.rfind("LDX", 0) == 0) msg = range(4, 5);
+          else msg = range(3, 4);  // STX, STXS
+          break;
+        case TrapKind::RangeError: msg = fmt::format("value {} outside subrange {}..{}", num(a), num(b), num(cc)); break;
+        case TrapKind::NullReference: msg = "dereference of a null reference"; break;
+        case TrapKind::Watchdog: msg = fmt::format("more than {} loop iterations in one call (endless loop?)", vm.budget_limit_); break;
+        case TrapKind::CallDepth: msg = a == 1 ? "method stack overflow (recursion?)" : "call depth exceeded (recursion?)"; break;
+        case TrapKind::NotImplemented: msg = "the instance's type does not implement this method"; break;
+        case TrapKind::BadAddress: msg = fmt::format("address {} outside memory", static_cast<uint64_t>(a)); break;
+        default: msg = trap_name(k); break;
+      }
+    }
+    vm.fail(k, w, std::move(msg));
+    return native_abi::kTrap;
+  }
+
+  static int call_entry(native_abi::Ctx* c, uint32_t entry, uint8_t* base) {
+    Machine& vm = m(c);
+    if (native_abi::Fn fn = vm.native_->find(entry)) return fn(c, base);
+    int64_t budget = c->budget;
+    bool ok = vm.run(vm.app_->code.data() + entry, base, c->mtop, &budget);
+    c->budget = budget;
+    return ok ? native_abi::kOk : native_abi::kTrap;
+  }
+
+  static void native_fn(native_abi::Ctx* c, uint32_t id, uint8_t* a, uint8_t* b, uint8_t* cc, uint8_t* d) {
+    native(id & 0xffffu)(m(c), id >> 16, a, b, cc, d);
+  }
+
+  static int assert_fn(native_abi::Ctx* c, uint32_t pc, uint8_t* base) {
+    Machine& vm = m(c);
+    return vm.do_assert(vm.app_->code.data() + pc, base) ? native_abi::kOk : native_abi::kTrap;
+  }
+};
+
+bool Machine::call_native(const void* fn, uint8_t* base) {
+  native_abi::Ctx c{};
+  c.mem = mem_.data();
+  c.msize = mem_.size();
+  c.taken = taken_.data();
+  c.now = &now_ns_;
+  c.vtable = app_->vtable.data();
+  c.budget = static_cast<int64_t>(budget_limit_);
+  c.depth = 0;
+  c.mtop = app_->mstack_addr;
+  c.mend = app_->mstack_addr + app_->mstack_size;
+  c.host = this;
+  c.trap = &NativeBridge::trap;
+  c.call_entry = &NativeBridge::call_entry;
+  c.native_fn = &NativeBridge::native_fn;
+  c.assert_fn = &NativeBridge::assert_fn;
+  return reinterpret_cast<native_abi::Fn>(const_cast<void*>(fn))(&c, base) != native_abi::kTrap;
 }
 
 // Dispatch uses computed goto (a GNU extension, as CPython's and Lua's fast paths do):
 // one indirect jump per instruction, predicted per opcode site.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpedantic"
-bool Machine::run(const uint32_t* pc, uint8_t* base) {
+bool Machine::run(const uint32_t* pc, uint8_t* base, uint32_t mtop, int64_t* budget_io) {
   uint8_t* const mem = mem_.data();
   const uint64_t msize = mem_.size();
   const uint32_t* const code = app_->code.data();
@@ -192,9 +184,8 @@ bool Machine::run(const uint32_t* pc, uint8_t* base) {
   const uint32_t n_types = app_->n_types;
   uint64_t* const taken = taken_.data();
   size_t sp = 0;
-  uint32_t mtop = app_->mstack_addr;
   const uint32_t mend = app_->mstack_addr + app_->mstack_size;
-  int64_t budget = static_cast<int64_t>(budget_limit_);
+  int64_t budget = *budget_io;
 
   static const void* const kLabels[] = {
 #define OP(name, nargs, rtl) &&L_##name,
@@ -225,9 +216,13 @@ bool Machine::run(const uint32_t* pc, uint8_t* base) {
 L_NOP:
   NEXT(0);
 L_HALT:
+  *budget_io = budget;
   return true;
 L_RET:
-  if (sp == 0) return true;
+  if (sp == 0) {
+    *budget_io = budget;
+    return true;
+  }
   --sp;
   pc = stack_[sp].pc;
   base = stack_[sp].base;
@@ -577,13 +572,8 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
 
 #define DIVK_IMPL(NAME, T, IS_MOD)                                                      \
   L_##NAME: {                                                                           \
-    int64_t n = R(T, 2);                                                                \
     uint64_t m = static_cast<uint64_t>(pc[3]) | (static_cast<uint64_t>(pc[4]) << 32);   \
-    int64_t k = static_cast<int32_t>(pc[5]);                                            \
-    uint64_t un = static_cast<uint64_t>(n < 0 ? -n : n);                                \
-    auto q = static_cast<int64_t>(static_cast<uint64_t>((static_cast<U128>(un) * m) >> 63)); \
-    if ((n < 0) != (k < 0)) q = -q;                                                     \
-    W(T, 1, static_cast<T>(IS_MOD ? n - q * k : q));                                    \
+    W(T, 1, (divk<T, IS_MOD>(R(T, 2), m, static_cast<int32_t>(pc[5]))));                \
     NEXT(5);                                                                            \
   }
   DIVK_IMPL(DIVK_I16, int16_t, false)

@@ -33,6 +33,7 @@ struct Trap {
 };
 
 class Machine;
+class NativeCode;
 // Natives implement the standard functions the compiler does not open-code
 // (string functions, transcendental math, conversions to and from text).
 using NativeFn = void (*)(Machine& m, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d);
@@ -77,10 +78,19 @@ class Machine {
   // Assertion bookkeeping for the test runner.
   const std::string& assert_message() const { return assert_message_; }
 
+  // The native tier (native/native.hpp): entries it has run natively, the rest in the
+  // interpreter. nullptr: interpreter only. The code must outlive the machine's use of it.
+  void set_native(const NativeCode* code) { native_ = code; }
+  const NativeCode* native_code() const { return native_; }
+
  private:
   friend struct VmAccess;
+  friend struct NativeBridge;
   bool fail(TrapKind k, const uint32_t* pc, std::string msg);
-  bool run(const uint32_t* pc, uint8_t* base);
+  // Interprets from pc until the matching RET. mtop: the method stack top; budget: the
+  // backward jumps left (read and, on a normal return, written back).
+  bool run(const uint32_t* pc, uint8_t* base, uint32_t mtop, int64_t* budget);
+  bool call_native(const void* fn, uint8_t* base);
   bool do_assert(const uint32_t* pc, uint8_t* base);
 
   const Application* app_;
@@ -90,6 +100,7 @@ class Machine {
   uint64_t budget_limit_ = 100'000'000;
   Trap trap_;
   std::string assert_message_;
+  const NativeCode* native_ = nullptr;
   struct Frame {
     const uint32_t* pc;
     uint8_t* base;

@@ -1,0 +1,135 @@
+// The arithmetic of the VM's instructions: wraparound, saturating conversions, shifts and
+// rotations, division by a constant. Shared by the interpreter (vm.cpp) and by the
+// native tier, whose generated C++ includes this file verbatim (so it depends on the
+// standard library only): both execute an instruction with the same code.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+
+namespace plcfi::st::ops {
+
+template <class T>
+inline T ld(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return v;
+}
+template <class T>
+inline void st(uint8_t* p, T v) {
+  std::memcpy(p, &v, sizeof(T));
+}
+
+__extension__ typedef unsigned __int128 U128;  // one MUL on x86-64 and AArch64
+
+// Two's-complement wraparound without undefined behaviour (IEC integer overflow wraps).
+template <class T>
+using Wide = std::conditional_t<(sizeof(T) < 4), uint32_t, std::make_unsigned_t<T>>;
+template <class T>
+inline T wadd(T a, T b) {
+  if constexpr (std::is_floating_point_v<T>) return a + b;
+  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) +
+                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
+}
+template <class T>
+inline T wsub(T a, T b) {
+  if constexpr (std::is_floating_point_v<T>) return a - b;
+  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) -
+                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
+}
+template <class T>
+inline T wmul(T a, T b) {
+  if constexpr (std::is_floating_point_v<T>) return a * b;
+  else return static_cast<T>(static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(a)) *
+                             static_cast<Wide<T>>(static_cast<std::make_unsigned_t<T>>(b)));
+}
+template <class T>
+inline T wneg(T a) {
+  if constexpr (std::is_floating_point_v<T>) return -a;
+  else return wsub<T>(T(0), a);
+}
+template <class T>
+inline T wdiv(T a, T b) {  // b != 0 checked by the caller for integers
+  if constexpr (std::is_signed_v<T> && std::is_integral_v<T>) {
+    if (b == T(-1)) return wneg(a);
+  }
+  return static_cast<T>(a / b);
+}
+template <class T>
+inline T wmod(T a, T b) {
+  if constexpr (std::is_signed_v<T>) {
+    if (b == T(-1)) return T(0);
+  }
+  return static_cast<T>(a % b);
+}
+template <class T>
+inline T wabs(T a) {
+  if constexpr (std::is_floating_point_v<T>) return std::fabs(a);
+  else if constexpr (std::is_signed_v<T>) return a < 0 ? wneg(a) : a;
+  else return a;
+}
+// Conversions saturate where C++ would be undefined (float to integer out of range, NaN).
+template <class To, class From>
+inline To cvt(From v) {
+  if constexpr (std::is_integral_v<To> && std::is_floating_point_v<From>) {
+    if (std::isnan(v)) return To(0);
+    if (v <= static_cast<From>(std::numeric_limits<To>::min())) return std::numeric_limits<To>::min();
+    if (v >= static_cast<From>(std::numeric_limits<To>::max())) return std::numeric_limits<To>::max();
+    return static_cast<To>(v);
+  } else {
+    return static_cast<To>(v);
+  }
+}
+template <class T>
+inline T shl(T v, uint64_t n) {
+  using U = std::make_unsigned_t<T>;
+  if (n >= sizeof(T) * 8) return T(0);
+  return static_cast<T>(static_cast<U>(static_cast<Wide<T>>(static_cast<U>(v)) << n));
+}
+template <class T>
+inline T shr(T v, uint64_t n) {
+  using U = std::make_unsigned_t<T>;
+  if (n >= sizeof(T) * 8) return T(0);
+  return static_cast<T>(static_cast<U>(static_cast<U>(v) >> n));
+}
+template <class T>
+inline T rol(T v, uint64_t n) {
+  constexpr uint64_t w = sizeof(T) * 8;
+  n %= w;
+  if (n == 0) return v;
+  return static_cast<T>(shl(v, n) | shr(v, w - n));
+}
+template <class T>
+inline T ror(T v, uint64_t n) {
+  constexpr uint64_t w = sizeof(T) * 8;
+  n %= w;
+  if (n == 0) return v;
+  return static_cast<T>(shr(v, n) | shl(v, w - n));
+}
+inline float f32_bits(uint32_t b) {
+  float f;
+  std::memcpy(&f, &b, 4);
+  return f;
+}
+inline double f64_bits(uint64_t b) {
+  double d;
+  std::memcpy(&d, &b, 8);
+  return d;
+}
+
+// DIVK/MODK: q = floor(|n| * M / 2^63), M = floor(2^63/|K|) + 1, exact for 32-bit n;
+// the sign of the dividend (IEC truncates toward zero).
+template <class T, bool IsMod>
+inline T divk(T nv, uint64_t m, int32_t kv) {
+  int64_t n = nv;
+  int64_t k = kv;
+  uint64_t un = static_cast<uint64_t>(n < 0 ? -n : n);
+  auto q = static_cast<int64_t>(static_cast<uint64_t>((static_cast<U128>(un) * m) >> 63));
+  if ((n < 0) != (k < 0)) q = -q;
+  return static_cast<T>(IsMod ? n - q * k : q);
+}
+
+}  // namespace plcfi::st::ops

@@ -1,0 +1,154 @@
+// The native tier against the interpreter: same memory, coverage and clock after every
+// scan, and the same trap (kind, location, message) for every kind of runtime error.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "engine.hpp"
+#include "native/native.hpp"
+
+namespace plcfi::st {
+namespace {
+
+std::string read_file(const std::string& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+struct Pair {
+  std::unique_ptr<Build> b;
+  std::unique_ptr<NativeCode> native;
+};
+
+Pair build_both(const std::vector<std::pair<std::string, std::string>>& sources) {
+  Pair p;
+  p.b = build_sources(sources, CompileOptions{});
+  EXPECT_TRUE(p.b->ok()) << p.b->diags.render_all();
+  if (!p.b->ok()) return p;
+  std::string err;
+  p.native = NativeCode::build(*p.b->app, NativeOptions{}, &err);
+  EXPECT_TRUE(p.native) << err;
+  if (p.native) {
+    EXPECT_EQ(p.native->interpreted(), 0u);
+  }
+  return p;
+}
+
+// Runs `scans` scans of every program instance in both tiers, comparing after each.
+// Returns the scan that trapped (or -1); the traps must agree.
+int compare_runs(const Pair& p, int scans, uint64_t budget = 100'000) {
+  const Application& app = *p.b->app;
+  Machine a(app), n(app);
+  a.set_budget(budget);
+  n.set_budget(budget);
+  n.set_native(p.native.get());
+  for (int s = 0; s < scans; ++s) {
+    a.set_now(s * 10'000'000LL);
+    n.set_now(s * 10'000'000LL);
+    for (const auto& inst : app.programs) {
+      bool ra = a.call(inst.pou->entry, inst.addr);
+      bool rn = n.call(inst.pou->entry, inst.addr);
+      EXPECT_EQ(ra, rn) << "scan " << s << " program " << inst.name;
+      EXPECT_EQ(static_cast<int>(a.trap().kind), static_cast<int>(n.trap().kind));
+      EXPECT_EQ(a.trap().pc, n.trap().pc);
+      EXPECT_EQ(a.trap().message, n.trap().message);
+      EXPECT_EQ(describe_trap(app, a.trap()), describe_trap(app, n.trap()));
+      EXPECT_EQ(0, std::memcmp(a.mem(), n.mem(), a.mem_size())) << "memory differs after scan " << s;
+      EXPECT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
+      EXPECT_EQ(a.now(), n.now());
+      if (!ra) return s;
+    }
+  }
+  return -1;
+}
+
+TEST(NativeTier, StampingProgramScansLikeTheInterpreter) {
+  Pair p = build_both({{"stamping.st", read_file(std::string(PLCFI_SOURCE_DIR) + "/st_programs/stamping/stamping.st")}});
+  ASSERT_TRUE(p.native);
+  EXPECT_EQ(compare_runs(p, 500), -1);
+}
+
+TEST(NativeTier, BenchKernelsScanLikeTheInterpreter) {
+  for (const char* k : {"state_machine", "int_loop", "real_math", "array_struct", "fb_calls"}) {
+    SCOPED_TRACE(k);
+    std::string file = std::string(k) + ".st";
+    Pair p = build_both({{file, read_file(std::string(PLCFI_SOURCE_DIR) + "/tests/bench/kernels/" + file)}});
+    ASSERT_TRUE(p.native);
+    EXPECT_EQ(compare_runs(p, 50, 10'000'000), -1);
+  }
+}
+
+// Each program traps on its 3rd scan; both tiers must report the same trap.
+struct TrapCase {
+  const char* name;
+  const char* body;  // statements; n counts the scans
+  const char* vars;
+  TrapKind kind;
+};
+
+class NativeTraps : public ::testing::TestWithParam<TrapCase> {};
+
+TEST_P(NativeTraps, SameTrapKindLocationAndMessage) {
+  const TrapCase& c = GetParam();
+  std::string src = std::string("PROGRAM P\nVAR\n  n : DINT;\n  zero : DINT;\n") + c.vars + "END_VAR\nn := n + 1;\nIF n >= 3 THEN\n" +
+                    c.body + "\nEND_IF;\nEND_PROGRAM\n";
+  Pair p = build_both({{"p.st", src}});
+  ASSERT_TRUE(p.native);
+  EXPECT_EQ(compare_runs(p, 5), 2);
+  Machine n(*p.b->app);
+  n.set_budget(100'000);
+  n.set_native(p.native.get());
+  const auto& inst = p.b->app->programs[0];
+  for (int i = 0; i < 3; ++i) n.call(inst.pou->entry, inst.addr);
+  EXPECT_EQ(static_cast<int>(n.trap().kind), static_cast<int>(c.kind)) << n.trap().message;
+  // The statement's line: after the header (7 lines) and the extra declarations.
+  auto line = 8u + static_cast<uint32_t>(std::count(c.vars, c.vars + std::strlen(c.vars), '\n'));
+  EXPECT_EQ(n.trap().loc.line, line) << describe_trap(*p.b->app, n.trap());
+}
+
+const TrapCase kTraps[] = {
+    {"division", "  n := 100 / zero;", "", TrapKind::DivisionByZero},
+    {"modulo", "  n := 100 MOD zero;", "", TrapKind::DivisionByZero},
+    {"index_frame_array", "  a[n * 5] := 1;", "  a : ARRAY[1..10] OF DINT;\n", TrapKind::IndexOutOfRange},
+    {"index_read", "  n := a[n - 10];", "  a : ARRAY[1..10] OF DINT;\n", TrapKind::IndexOutOfRange},
+    {"index_struct_array", "  r[n * 5].x := 1;", "  r : ARRAY[1..4] OF STRUCT x : INT; y : REAL; END_STRUCT;\n",
+     TrapKind::IndexOutOfRange},
+    {"subrange", "  s := DINT_TO_INT(n * 10);", "  s : INT(0..20);\n", TrapKind::RangeError},
+    {"watchdog", "  WHILE TRUE DO n := n + 1; END_WHILE;", "", TrapKind::Watchdog},
+    {"for_watchdog", "  FOR i := 0 TO 1000000 DO n := n + 1; END_FOR;", "  i : DINT;\n", TrapKind::Watchdog},
+    {"null_reference", "  n := r^;", "  r : REF_TO DINT;\n", TrapKind::NullReference},
+};
+
+INSTANTIATE_TEST_SUITE_P(All, NativeTraps, ::testing::ValuesIn(kTraps),
+                         [](const ::testing::TestParamInfo<TrapCase>& i) { return std::string(i.param.name); });
+
+TEST(NativeTier, MissingCompilerIsAClearError) {
+  auto b = build_sources({{"p.st", "PROGRAM P\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n"}}, CompileOptions{});
+  ASSERT_TRUE(b->ok());
+  NativeOptions o;
+  o.compiler = "/nonexistent/c++";
+  o.cache_dir = ::testing::TempDir() + "plcfi_native_missing_cc";
+  std::string err;
+  EXPECT_EQ(NativeCode::build(*b->app, o, &err), nullptr);
+  EXPECT_NE(err.find("cannot run the C++ compiler '/nonexistent/c++'"), std::string::npos) << err;
+}
+
+TEST(NativeTier, SecondBuildComesFromTheCache) {
+  auto b = build_sources({{"p.st", "PROGRAM P\nVAR x : INT; END_VAR\nx := x + 2;\nEND_PROGRAM\n"}}, CompileOptions{});
+  ASSERT_TRUE(b->ok());
+  std::string err;
+  auto first = NativeCode::build(*b->app, NativeOptions{}, &err);
+  ASSERT_TRUE(first) << err;
+  auto second = NativeCode::build(*b->app, NativeOptions{}, &err);
+  ASSERT_TRUE(second) << err;
+  EXPECT_TRUE(second->from_cache());
+  EXPECT_EQ(first->library(), second->library());
+}
+
+}  // namespace
+}  // namespace plcfi::st
