@@ -399,8 +399,9 @@ class Translator {
       case Op::MODK_I32: {
         const char* t = op == Op::DIVK_I16 || op == Op::MODK_I16 ? "int16_t" : "int32_t";
         bool mod = op == Op::MODK_I16 || op == Op::MODK_I32;
-        uint64_t m = static_cast<uint64_t>(w[3]) | (static_cast<uint64_t>(w[4]) << 32);
-        s = W(t, 1, fmt::format("(divk<{}, {}>({}, {}ull, {}))", t, mod ? "true" : "false", R(t, 2), m, S(5)));
+        // |K| >= 2: C's truncating division by the literal is the instruction's result
+        // (no overflow), and the C++ compiler picks the best multiply-shift sequence.
+        s = W(t, 1, fmt::format("({})((int32_t){} {} (int32_t){})", t, R(t, 2), mod ? "%" : "/", S(5)));
         return true;
       }
       default: break;
