@@ -47,11 +47,25 @@ END_CASE
 END_PROGRAM
 )";
 
+// Every temporary file goes away when the test program ends.
+struct TempFiles {
+  std::vector<std::string> paths;
+  ~TempFiles() {
+    std::error_code ec;
+    for (const auto& p : paths) std::filesystem::remove(p, ec);
+  }
+};
+std::string remember_temp(std::string p) {
+  static TempFiles files;
+  files.paths.push_back(p);
+  return p;
+}
+
 std::string temp(const std::string& text) {
   static int n = 0;
   fs::path p = fs::temp_directory_path() / ("plcfi_gpio_" + std::to_string(::getpid()) + "_" + std::to_string(n++) + ".yaml");
   std::ofstream(p) << text;
-  return p.string();
+  return remember_temp(p.string());
 }
 
 class GpioTest : public ::testing::Test {

@@ -51,10 +51,24 @@ hr := ir + 1;
 END_PROGRAM
 )";
 
+// Every temporary file goes away when the test program ends.
+struct TempFiles {
+  std::vector<std::string> paths;
+  ~TempFiles() {
+    std::error_code ec;
+    for (const auto& p : paths) std::filesystem::remove(p, ec);
+  }
+};
+std::string remember_temp(std::string p) {
+  static TempFiles files;
+  files.paths.push_back(p);
+  return p;
+}
+
 std::string temp(const std::string& name, const std::string& text) {
   fs::path p = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".yaml");
   std::ofstream(p) << text;
-  return p.string();
+  return remember_temp(p.string());
 }
 
 int free_port() {

@@ -17,6 +17,20 @@
 namespace plcfi::monitor {
 namespace {
 
+// Every temporary file goes away when the test program ends.
+struct TempFiles {
+  std::vector<std::string> paths;
+  ~TempFiles() {
+    std::error_code ec;
+    for (const auto& p : paths) std::filesystem::remove(p, ec);
+  }
+};
+std::string remember_temp(std::string p) {
+  static TempFiles files;
+  files.paths.push_back(p);
+  return p;
+}
+
 // Temporary files are unique per test and process: ctest runs tests in parallel.
 std::string write_temp(const std::string& name, const std::string& text) {
   static int counter = 0;
@@ -26,7 +40,7 @@ std::string write_temp(const std::string& name, const std::string& text) {
   auto p = (std::filesystem::temp_directory_path() / unique).string();
   std::ofstream f(p);
   f << text;
-  return p;
+  return remember_temp(p);
 }
 
 // Runs one requirements text on one CSV text; cycle_ns as for `plcfi edtl check`.
