@@ -307,6 +307,44 @@ TEST_F(ModbusIo, KeepsLastGoodInputsAndReconnectsAfterAnOutage) {
   EXPECT_EQ(get(r, "P.ir"), 41);
 }
 
+// Lost communication with one device: the run ends, and the safe state still reaches
+// the devices that answer (what plcfi run and campaign do on that way out).
+TEST_F(ModbusIo, LostDeviceEndsTheRunAndTheOthersGetTheSafeState) {
+  int port_a = free_port(), port_b = free_port();
+  auto a = std::make_unique<LibmodbusServer>(port_a);
+  LibmodbusServer b(port_b);
+  std::string text = "io:\n  devices:\n"
+                     "    - {name: a, tcp: \"127.0.0.1:" + std::to_string(port_a) + "\", timeout: 100ms, lost_after: 300ms, "
+                     "reconnect: {min: 50ms, max: 100ms}}\n"
+                     "    - {name: b, tcp: \"127.0.0.1:" + std::to_string(port_b) + "\", timeout: 100ms}\n"
+                     "  map:\n"
+                     "    - {image: \"%IX0.0\", count: 1, device: a, discrete_inputs: 0}\n"
+                     "    - {image: \"%QX0.0\", count: 1, device: a, coils: 4}\n"
+                     "    - {image: \"%QX0.1\", count: 1, device: b, coils: 5}\n"
+                     "    - {image: \"%QW2\", count: 1, device: b, holding_registers: 10}\n"
+                     "  safe_state: {\"%QW2\": 7}\n";
+  IoConfig cfg;
+  std::string err;
+  ASSERT_TRUE(load_io_config(temp("plcfi_io_two", text), *b_->app, &cfg, &err)) << err;
+  auto mb = ModbusBackend::create(cfg, 1'000'000'000, &err);
+  ASSERT_TRUE(mb) << err;
+  rt::Runtime r(*b_->app, sched_, mb.get());
+  r.set_safe_state(cfg.safe_state);
+  r.cold_restart(1);
+  // di0 = 1 on device a: the program drives co0 := di0 (a) and co1 := NOT di1 (b).
+  ASSERT_TRUE(scan_until(r, [&] { return b.map()->tab_bits[5] == 1 && a->map()->tab_bits[4] == 1; }));
+  EXPECT_NE(b.map()->tab_registers[10], 7);
+  a->stop();
+  auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(scan_until(r, [&] { return mb->lost_device() != SIZE_MAX; }));
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(3));
+  EXPECT_EQ(mb->lost_device(), 0u);
+  r.write_safe_outputs();
+  EXPECT_EQ(b.map()->tab_bits[5], 0);         // off
+  EXPECT_EQ(b.map()->tab_registers[10], 7);   // the configured safe value
+  EXPECT_TRUE(mb->stats()[1].up);
+}
+
 TEST_F(ModbusIo, UnreachableDeviceNeitherHangsNorCrashes) {
   int port = free_port();  // nobody listens
   auto mb = backend(io_text("tcp: \"127.0.0.1:" + std::to_string(port) + "\"\n      lost_after: 100ms"));
