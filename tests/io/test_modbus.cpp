@@ -175,7 +175,7 @@ TEST_F(ModbusIo, Ipv6AndHostNamesParse) {
 // A libmodbus TCP server on a thread; stop() closes every socket (a crashed device).
 class LibmodbusServer {
  public:
-  explicit LibmodbusServer(int port) : port_(port) {
+  explicit LibmodbusServer(int port, std::string host = "127.0.0.1") : port_(port), host_(std::move(host)) {
     map_ = modbus_mapping_new(32, 32, 32, 32);
     map_->tab_input_bits[0] = 1;
     map_->tab_input_bits[2] = 1;
@@ -189,8 +189,14 @@ class LibmodbusServer {
   }
   void start() {
     stop_ = false;
-    ctx_ = modbus_new_tcp("127.0.0.1", port_);
-    listen_ = modbus_tcp_listen(ctx_, 4);  // libmodbus sets SO_REUSEADDR: a restart rebinds at once
+    // libmodbus sets SO_REUSEADDR: a restart rebinds at once.
+    if (host_.find(':') != std::string::npos) {  // IPv6: the protocol-independent calls
+      ctx_ = modbus_new_tcp_pi(host_.c_str(), std::to_string(port_).c_str());
+      listen_ = modbus_tcp_pi_listen(ctx_, 4);
+    } else {
+      ctx_ = modbus_new_tcp(host_.c_str(), port_);
+      listen_ = modbus_tcp_listen(ctx_, 4);
+    }
     thread_ = std::thread([this] { loop(); });
   }
   void stop() {
@@ -217,7 +223,7 @@ class LibmodbusServer {
       timeval tv{0, 20'000};
       if (select(mx + 1, &rd, nullptr, nullptr, &tv) <= 0) continue;
       if (FD_ISSET(listen_, &rd)) {
-        int c = modbus_tcp_accept(ctx_, &listen_);
+        int c = host_.find(':') != std::string::npos ? modbus_tcp_pi_accept(ctx_, &listen_) : modbus_tcp_accept(ctx_, &listen_);
         if (c >= 0) clients.push_back(c);
       }
       for (size_t i = 0; i < clients.size();) {
@@ -243,6 +249,7 @@ class LibmodbusServer {
     modbus_set_socket(ctx_, -1);
   }
   int port_;
+  std::string host_;
   modbus_t* ctx_ = nullptr;
   modbus_mapping_t* map_ = nullptr;
   int listen_ = -1;
@@ -280,6 +287,22 @@ TEST_F(ModbusIo, ExchangesTheImageInTheScan) {
   r.scan();
   EXPECT_EQ(server.requests.load() - before, 5);
   EXPECT_EQ(mb->stats()[0].failures, 0u);
+}
+
+// TCP by IPv6 address and by host name (modbus_new_tcp_pi resolves both).
+TEST_F(ModbusIo, ExchangesOverIpv6AndByHostName) {
+  for (const auto& [server_host, device] : {std::pair<std::string, std::string>{"::1", "[::1]"}, {"127.0.0.1", "localhost"}}) {
+    SCOPED_TRACE(device);
+    int port = free_port();
+    LibmodbusServer server(port, server_host);
+    auto mb = backend(io_text("tcp: \"" + device + ":" + std::to_string(port) + "\""));
+    ASSERT_TRUE(mb);
+    rt::Runtime r(*b_->app, sched_, mb.get());
+    r.cold_restart(1);
+    ASSERT_TRUE(scan_until(r, [&] { return server.map()->tab_registers[10] == 42; })) << mb->last_error();
+    EXPECT_EQ(get(r, "P.linkOk"), 1);
+    EXPECT_EQ(server.map()->tab_bits[4], 1);
+  }
 }
 
 TEST_F(ModbusIo, KeepsLastGoodInputsAndReconnectsAfterAnOutage) {
