@@ -90,9 +90,8 @@ class Translator {
     collect();
     std::ostringstream body;
     std::vector<uint32_t> ok;
-    for (size_t i = 0; i < starts_.size(); ++i) {
-      uint32_t start = starts_[i];
-      uint32_t end = i + 1 < starts_.size() ? starts_[i + 1] : static_cast<uint32_t>(code_.size());
+    for (uint32_t start : starts_) {
+      uint32_t end = next_start(start);
       std::string f;
       if (function(start, end, &f)) {
         body << f;
@@ -131,9 +130,10 @@ class Translator {
   }
 
  private:
+  // The end of the function at s: the next entry of any POU (reachable or not).
   uint32_t next_start(uint32_t s) const {
-    auto it = std::upper_bound(starts_.begin(), starts_.end(), s);
-    return it == starts_.end() ? static_cast<uint32_t>(code_.size()) : *it;
+    auto it = std::upper_bound(bounds_.begin(), bounds_.end(), s);
+    return it == bounds_.end() ? static_cast<uint32_t>(code_.size()) : *it;
   }
 
   // Every entry reachable from the application's roots: programs, observers, tests, and
