@@ -109,8 +109,13 @@ ScanStatus Runtime::scan() {
   }
   machine_.merge_coverage();
   for (ScanHooks* h : hooks_) h->after_scan(*this);
-  if (stopped_) fill_safe(mem + app_->image_q.addr);  // safe state
-  out_overlay_.apply(out_.data(), mem + app_->image_q.addr, out_extent(), now_ns_);
+  if (stopped_) {
+    // Stopped (a trap): the safe state goes out as it is; no actuator fault overrides it.
+    fill_safe(mem + app_->image_q.addr);
+    std::memcpy(out_.data(), mem + app_->image_q.addr, out_extent());
+  } else {
+    out_overlay_.apply(out_.data(), mem + app_->image_q.addr, out_extent(), now_ns_);
+  }
   if (backend_ && !backend_->write(out_.data(), now_ns_, tick) && status == ScanStatus::Ok) status = ScanStatus::IoError;
   for (ScanHooks* h : hooks_) h->end_of_scan(*this);
   ++scans_;

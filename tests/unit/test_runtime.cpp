@@ -222,6 +222,37 @@ END_PROGRAM
   EXPECT_EQ(1, fb.last_out & 1);
 }
 
+TEST(Runtime, AnActuatorFaultDoesNotOverrideTheSafeStateAfterATrap) {
+  auto b = build(R"(
+PROGRAM P
+VAR
+  valve AT %QX0.0 : BOOL;
+  n : INT;
+  d : INT;
+END_VAR
+n := n + 1;
+IF n = 2 THEN
+  n := 10 / d;
+END_IF;
+END_PROGRAM
+)");
+  Schedule s;
+  std::string err;
+  ASSERT_TRUE(s.single_program(*b->app, "", 10'000'000, &err));
+  FakeBackend fb;
+  Runtime r(*b->app, s, &fb);
+  r.cold_restart(1);
+  ImageRef ref;
+  ASSERT_TRUE(parse_image_ref(*b->app, "%QX0.0", &ref, &err)) << err;
+  r.output_overlay().add(std::make_unique<ForceRule>(ref, 1));  // the valve stuck on
+  EXPECT_EQ(ScanStatus::Ok, r.scan());
+  EXPECT_EQ(1, fb.last_out & 1);  // the fault acts while the program runs
+  EXPECT_EQ(ScanStatus::Trapped, r.scan());
+  EXPECT_EQ(0, fb.last_out & 1) << "the safe state, not the injected fault, after a trap";
+  EXPECT_EQ(ScanStatus::Stopped, r.scan());
+  EXPECT_EQ(0, fb.last_out & 1);
+}
+
 TEST(Runtime, TasksWithSeveralIntervalsRunAtTheirTicksInPriorityOrder) {
   auto b = build(R"(
 VAR_GLOBAL
