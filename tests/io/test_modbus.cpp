@@ -6,11 +6,13 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <thread>
 
 #include <modbus/modbus.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <spawn.h>
 #include <sys/select.h>
@@ -366,6 +368,24 @@ TEST_F(ModbusIo, LostDeviceEndsTheRunAndTheOthersGetTheSafeState) {
   EXPECT_EQ(b.map()->tab_bits[5], 0);         // off
   EXPECT_EQ(b.map()->tab_registers[10], 7);   // the configured safe value
   EXPECT_TRUE(mb->stats()[1].up);
+}
+
+// RS485 on a line that cannot do it (a pty): the error names the device and the mode.
+TEST_F(ModbusIo, Rs485ModeOnALineWithoutItIsAnErrorNamingTheDevice) {
+  int master = posix_openpt(O_RDWR | O_NOCTTY);
+  ASSERT_GE(master, 0);
+  ASSERT_EQ(grantpt(master), 0);
+  ASSERT_EQ(unlockpt(master), 0);
+  std::string dev = ptsname(master);
+  auto mb = backend(io_text("rtu: {device: \"" + dev + "\", baud: 19200, parity: E, mode: rs485}"));
+  ASSERT_TRUE(mb);
+  rt::Runtime r(*b_->app, sched_, mb.get());
+  r.cold_restart(1);
+  EXPECT_EQ(r.scan(), rt::ScanStatus::IoError);
+  EXPECT_EQ(get(r, "P.linkOk"), 0);
+  EXPECT_NE(mb->last_error().find("unit1 (" + dev + ") unit 1: RS485 mode: "), std::string::npos) << mb->last_error();
+  mb->close();
+  ::close(master);
 }
 
 TEST_F(ModbusIo, UnreachableDeviceNeitherHangsNorCrashes) {

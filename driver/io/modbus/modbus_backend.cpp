@@ -131,8 +131,10 @@ bool ModbusBackend::ensure(size_t i, int64_t now) {
     drop(i, now, std::string("connect: ") + modbus_strerror(errno));
     return false;
   }
-  if (c.rtu && c.rs485 && modbus_rtu_set_serial_mode(d.ctx, MODBUS_RTU_RS485) != 0) {
-    drop(i, now, std::string("RS485 mode: ") + modbus_strerror(errno));
+  // The serial mode is set on the open line (libmodbus needs the file descriptor);
+  // RS232 is the line's default, so setting it costs no ioctl.
+  if (c.rtu && modbus_rtu_set_serial_mode(d.ctx, c.rs485 ? MODBUS_RTU_RS485 : MODBUS_RTU_RS232) != 0) {
+    drop(i, now, std::string(c.rs485 ? "RS485" : "RS232") + " mode: " + modbus_strerror(errno));
     return false;
   }
   d.connected = true;
