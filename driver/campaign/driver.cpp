@@ -328,6 +328,7 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
   const Campaign& c = cb.spec;
   const st::Application& app = *cb.build->app;
   rt::Runtime runtime(app, cb.schedule, backend);
+  runtime.machine().set_native(opt.native);
   runtime.set_safe_state(opt.safe_state);
   // Every way out of this function, errors included: the fault withdrawn (both overlays
   // cleared) and the safe output state written to the backend.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "generate.hpp"
+#include "native/native.hpp"
 #include "runtime/backend.hpp"
 
 namespace plcfi::campaign {
@@ -57,6 +58,7 @@ struct DriverOptions {
   std::function<bool()> stop;
   std::function<std::string()> io_lost;
   std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
+  const st::NativeCode* native = nullptr;  // run program, preconditions and monitors natively
 };
 
 struct CampaignResult {

@@ -223,7 +223,8 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("arm", "allow fault injection on real I/O (required with io:)")
       ("realtime", "pace the scans in real time (always on with real I/O); report wake latency, execution time, overruns")
       ("rt-priority", po::value<int>()->default_value(0), "with real time: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
-      ("cpu", po::value<int>()->default_value(-1), "with real time: pin the scan thread to this CPU");
+      ("cpu", po::value<int>()->default_value(-1), "with real time: pin the scan thread to this CPU")
+      ("native", "run program, preconditions and monitors through the native tier");
   po::variables_map vm;
   if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
   CampaignBuild cb;
@@ -246,6 +247,9 @@ int cmd_campaign(const std::vector<std::string>& args) {
                            c.programs.back(), c.plant, c.seed);
   bool live = !vm.count("quiet") && isatty(STDERR_FILENO);
   campaign::DriverOptions opt;
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(*cb.build->app, "plcfi campaign"))) return 2;
+  opt.native = native.get();
   opt.out_dir = out;
   opt.resume = vm.count("resume") > 0;
   opt.vcd = !vm.count("no-vcd");
