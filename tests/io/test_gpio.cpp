@@ -6,6 +6,8 @@
 // outputs read back from sim_gpioN/value.
 #include <gtest/gtest.h>
 
+#include "../support/temp_files.hpp"
+
 #include <gpiod.h>
 
 #include <cstdlib>
@@ -47,19 +49,7 @@ END_CASE
 END_PROGRAM
 )";
 
-// Every temporary file goes away when the test program ends.
-struct TempFiles {
-  std::vector<std::string> paths;
-  ~TempFiles() {
-    std::error_code ec;
-    for (const auto& p : paths) std::filesystem::remove(p, ec);
-  }
-};
-std::string remember_temp(std::string p) {
-  static TempFiles files;
-  files.paths.push_back(p);
-  return p;
-}
+using testing_support::remember_temp;
 
 std::string temp(const std::string& text) {
   static int n = 0;

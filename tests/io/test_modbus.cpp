@@ -3,6 +3,8 @@
 // against an independent implementation (pymodbus) over TCP and over RTU on a pty pair.
 #include <gtest/gtest.h>
 
+#include "../support/temp_files.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -53,19 +55,7 @@ hr := ir + 1;
 END_PROGRAM
 )";
 
-// Every temporary file goes away when the test program ends.
-struct TempFiles {
-  std::vector<std::string> paths;
-  ~TempFiles() {
-    std::error_code ec;
-    for (const auto& p : paths) std::filesystem::remove(p, ec);
-  }
-};
-std::string remember_temp(std::string p) {
-  static TempFiles files;
-  files.paths.push_back(p);
-  return p;
-}
+using testing_support::remember_temp;
 
 std::string temp(const std::string& name, const std::string& text) {
   fs::path p = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()) + ".yaml");

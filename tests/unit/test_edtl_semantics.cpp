@@ -4,6 +4,8 @@
 // monitor with a direct implementation on random traces.
 #include <gtest/gtest.h>
 
+#include "../support/temp_files.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -17,19 +19,7 @@
 namespace plcfi::monitor {
 namespace {
 
-// Every temporary file goes away when the test program ends.
-struct TempFiles {
-  std::vector<std::string> paths;
-  ~TempFiles() {
-    std::error_code ec;
-    for (const auto& p : paths) std::filesystem::remove(p, ec);
-  }
-};
-std::string remember_temp(std::string p) {
-  static TempFiles files;
-  files.paths.push_back(p);
-  return p;
-}
+using testing_support::remember_temp;
 
 // Temporary files are unique per test and process: ctest runs tests in parallel.
 std::string write_temp(const std::string& name, const std::string& text) {

@@ -3,20 +3,19 @@
 #pragma once
 
 #include <cstdint>
-#include <cstring>
+
+#include "ops.hpp"
 
 namespace plcfi::st {
 
 template <class T>
 inline T load_as(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof(T));
-  return v;
+  return ops::ld<T>(p);
 }
 
 template <class T>
 inline void store_as(uint8_t* p, T v) {
-  std::memcpy(p, &v, sizeof(T));
+  ops::st<T>(p, v);
 }
 
 }  // namespace plcfi::st
