@@ -4,11 +4,15 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <random>
+#include <regex>
 #include <sstream>
 
 #include "engine.hpp"
 #include "native/native.hpp"
+#include "test_runner.hpp"
 
 namespace plcfi::st {
 namespace {
@@ -126,6 +130,62 @@ const TrapCase kTraps[] = {
 
 INSTANTIATE_TEST_SUITE_P(All, NativeTraps, ::testing::ValuesIn(kTraps),
                          [](const ::testing::TestParamInfo<TrapCase>& i) { return std::string(i.param.name); });
+
+// Differential fuzzing: conformance tests with one integer literal changed (so asserts
+// fail, loops run longer, indexes leave their ranges...) give the same results, failure
+// messages and locations in both tiers.
+TEST(NativeTier, MutatedConformanceTestsGiveTheSameResults) {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::path(PLCFI_SOURCE_DIR) / "tests" / "st";
+  std::vector<fs::path> tests;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind("test_", 0) == 0) tests.push_back(e.path());
+  std::sort(tests.begin(), tests.end());
+  std::mt19937 rng(20261122);
+  const std::regex number(R"(\b[0-9]+\b)");
+  int compared = 0, failing = 0;
+  for (int round = 0; round < 24; ++round) {
+    const fs::path& t = tests[rng() % tests.size()];
+    std::string text = read_file(t.string());
+    std::vector<std::pair<size_t, size_t>> spots;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator(); ++it)
+      spots.emplace_back(static_cast<size_t>(it->position()), static_cast<size_t>(it->length()));
+    if (spots.empty()) continue;
+    auto [pos, len] = spots[rng() % spots.size()];
+    text.replace(pos, len, std::to_string(rng() % 40));
+    std::vector<std::pair<std::string, std::string>> sources;
+    std::string topic = t.filename().string().substr(5);
+    if (fs::exists(dir / topic)) sources.emplace_back(topic, read_file((dir / topic).string()));
+    sources.emplace_back(t.filename().string(), text);
+    CompileOptions opt;
+    opt.test_mode = true;
+    opt.warnings = false;
+    auto b = build_sources(sources, opt);
+    if (!b->ok() || b->app->tests.empty()) continue;  // the change made it ill-typed
+    SCOPED_TRACE(t.filename().string() + " with a literal at offset " + std::to_string(pos) + " changed");
+    std::string err;
+    auto native = NativeCode::build(*b->app, NativeOptions{}, &err);
+    ASSERT_TRUE(native) << err;
+    Machine a(*b->app), n(*b->app);
+    n.set_native(native.get());
+    TestRunOptions ro;
+    ro.budget = 200'000;
+    auto ra = run_tests(*b->app, a, ro);
+    auto rn = run_tests(*b->app, n, ro);
+    ASSERT_EQ(ra.size(), rn.size());
+    for (size_t i = 0; i < ra.size(); ++i) {
+      EXPECT_EQ(ra[i].name, rn[i].name);
+      EXPECT_EQ(ra[i].passed, rn[i].passed) << ra[i].name;
+      EXPECT_EQ(ra[i].where, rn[i].where) << ra[i].name;
+      EXPECT_EQ(ra[i].message, rn[i].message) << ra[i].name;
+      failing += !ra[i].passed;
+    }
+    ++compared;
+  }
+  std::printf("mutated programs compared: %d, failing tests among them: %d\n", compared, failing);
+  EXPECT_GE(compared, 8);
+  EXPECT_GE(failing, 3);  // the failure paths (asserts, traps) were exercised
+}
 
 TEST(NativeTier, MissingCompilerIsAClearError) {
   auto b = build_sources({{"p.st", "PROGRAM P\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n"}}, CompileOptions{});
