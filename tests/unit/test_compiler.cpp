@@ -1,5 +1,10 @@
 // Semantic diagnostics of the ST compiler: code, line, column and message of each error and warning, all errors in one run, and their rendering.
 #include <gtest/gtest.h>
+#include <sstream>
+#include <set>
+#include <regex>
+#include <fstream>
+#include <filesystem>
 
 #include <ostream>
 #include <string>
@@ -311,3 +316,26 @@ TEST(Compiler, GenericFunctionOfLiteralsAdaptsToTheTarget) {
 
 }  // namespace
 }  // namespace plcfi::st
+
+// Every diagnostic code the engine can emit is in the catalogue (driver/st/DIAGNOSTICS.md).
+TEST(DiagnosticsCatalogue, ListsEveryCodeTheEngineEmits) {
+  namespace fs = std::filesystem;
+  fs::path root = fs::path(PLCFI_SOURCE_DIR) / "driver" / "st";
+  std::ifstream cat_file(root / "DIAGNOSTICS.md");
+  std::stringstream cat;
+  cat << cat_file.rdbuf();
+  ASSERT_FALSE(cat.str().empty());
+  std::set<std::string> codes;
+  const std::regex code("\"(ST[0-9]{3})\"");
+  for (const auto& e : fs::recursive_directory_iterator(root)) {
+    if (e.path().extension() != ".cpp" && e.path().extension() != ".hpp") continue;
+    std::ifstream f(e.path());
+    std::stringstream ss;
+    ss << f.rdbuf();
+    std::string text = ss.str();
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), code); it != std::sregex_iterator(); ++it)
+      codes.insert((*it)[1]);
+  }
+  EXPECT_GT(codes.size(), 50u);
+  for (const auto& c : codes) EXPECT_NE(cat.str().find("| " + c + " |"), std::string::npos) << c << " is not in DIAGNOSTICS.md";
+}

@@ -13,7 +13,7 @@ enum class Severity { Note, Warning, Error };
 
 struct Diagnostic {
   Severity severity = Severity::Error;
-  std::string code;     // "ST101"; the catalogue is docs/diagnostics.md
+  std::string code;     // "ST101"; the catalogue is driver/st/DIAGNOSTICS.md
   std::string message;
   SourceLoc loc;
   // Secondary locations ("declared here").
