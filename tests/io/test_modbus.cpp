@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <thread>
 
 #include <modbus/modbus.h>
@@ -376,6 +377,73 @@ TEST_F(ModbusIo, Rs485ModeOnALineWithoutItIsAnErrorNamingTheDevice) {
   EXPECT_NE(mb->last_error().find("unit1 (" + dev + ") unit 1: RS485 mode: "), std::string::npos) << mb->last_error();
   mb->close();
   ::close(master);
+}
+
+// A peer that answers with garbage (a wrong header, a length it never sends, random
+// bytes, an exception for every request) is a communication error: counted, the status
+// bit cleared, the last good inputs kept; never a crash or a hang.
+TEST_F(ModbusIo, GarbageAnsweringPeerIsAnErrorNotACrash) {
+  int port = free_port();
+  int ls = socket(AF_INET, SOCK_STREAM, 0);
+  int one = 1;
+  setsockopt(ls, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  ASSERT_EQ(bind(ls, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+  ASSERT_EQ(listen(ls, 8), 0);
+  std::atomic<bool> stop{false};
+  std::thread peer([&] {
+    std::mt19937 rng(7);
+    int answer = 0;
+    while (!stop) {
+      fd_set rd;
+      FD_ZERO(&rd);
+      FD_SET(ls, &rd);
+      timeval tv{0, 20'000};
+      if (select(ls + 1, &rd, nullptr, nullptr, &tv) <= 0) continue;
+      int c = accept(ls, nullptr, nullptr);
+      if (c < 0) continue;
+      timeval rto{0, 200'000};
+      setsockopt(c, SOL_SOCKET, SO_RCVTIMEO, &rto, sizeof rto);
+      uint8_t q[260];
+      while (!stop && ::recv(c, q, sizeof q, 0) > 0) {
+        std::vector<uint8_t> r;
+        switch (answer++ % 4) {
+          case 0: r = {q[0], q[1], 0, 0, 0, 200, q[6], q[7], 1, 2};  // a length it never sends
+            break;
+          case 1: r = {static_cast<uint8_t>(q[0] + 1), q[1], 0, 0, 0, 3, q[6], q[7], 0};  // another transaction
+            break;
+          case 2: for (int i = 0; i < 40; ++i) r.push_back(static_cast<uint8_t>(rng()));  // noise
+            break;
+          default: r = {q[0], q[1], 0, 0, 0, 3, q[6], static_cast<uint8_t>(q[7] | 0x80), 4};  // exception 4
+        }
+        if (::send(c, r.data(), r.size(), MSG_NOSIGNAL) < 0) break;
+      }
+      ::close(c);
+    }
+  });
+  std::string text = io_text("tcp: \"127.0.0.1:" + std::to_string(port) + "\"");
+  text.replace(text.find("timeout: 200ms"), 14, "timeout: 50ms");
+  auto mb = backend(text);
+  ASSERT_TRUE(mb);
+  rt::Runtime r(*b_->app, sched_, mb.get());
+  r.cold_restart(1);
+  auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < 40; ++i) {
+    r.scan();
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(10));
+  EXPECT_EQ(get(r, "P.linkOk"), 0);
+  EXPECT_EQ(get(r, "P.ir"), 0);  // never a value from the garbage
+  EXPECT_GT(mb->stats()[0].failures + mb->stats()[0].disconnects, 0u);
+  EXPECT_FALSE(mb->last_error().empty());
+  mb->close();
+  stop = true;
+  peer.join();
+  ::close(ls);
 }
 
 TEST_F(ModbusIo, UnreachableDeviceNeitherHangsNorCrashes) {
