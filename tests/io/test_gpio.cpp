@@ -255,7 +255,9 @@ TEST_F(GpioSim, BiasAndActiveLow) {
                 "    - {image: \"%QX0.0\", device: board, lines: [4], active_low: true}\n",
                 &err);
   ASSERT_TRUE(g) << err;
-  EXPECT_EQ(g->describe().size(), 4u);  // flags differ: a request each
+  auto d = g->describe();
+  ASSERT_EQ(d.size(), 4u);  // three biases among the inputs: three requests; one output
+  EXPECT_NE(d[2].find("input lines 2,3 (one bulk request, active-low 2,3)"), std::string::npos) << d[2];
   rt::Runtime r(*b_->app, sched_, g.get());
   r.cold_restart(1);
   r.scan();
@@ -274,6 +276,35 @@ TEST_F(GpioSim, BiasAndActiveLow) {
   set(r, "P.mode", 2);  // q0 FALSE: high
   r.scan();
   EXPECT_EQ(value(4), 1);
+}
+
+TEST_F(GpioSim, ActiveLowLinesShareTheBulkRequest) {
+  std::string err;
+  auto g = open("    - {image: \"%IX0.0\", device: board, lines: [in0, in1]}\n"
+                "    - {image: \"%IX0.2\", device: board, lines: [in2, in3], active_low: true}\n"
+                "    - {image: \"%QX0.0\", device: board, lines: [out0, out1]}\n"
+                "    - {image: \"%QX0.2\", device: board, lines: [out2, out3], active_low: true}\n",
+                &err);
+  ASSERT_TRUE(g) << err;
+  auto d = g->describe();
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_NE(d[0].find("input lines 0,1,2,3 (one bulk request, active-low 2,3)"), std::string::npos) << d[0];
+  EXPECT_NE(d[1].find("output lines 4,5,6,7 (one bulk request, active-low 6,7)"), std::string::npos) << d[1];
+  // Requested in the safe state: all off, so the active-low lines are high.
+  EXPECT_EQ(value(4), 0);
+  EXPECT_EQ(value(6), 1);
+  rt::Runtime r(*b_->app, sched_, g.get());
+  r.cold_restart(1);
+  for (int i = 0; i < 4; ++i) pull(i, i % 2 == 0);  // in0 1, in1 0, in2 1, in3 0
+  r.scan();  // mode 0: q := i
+  EXPECT_EQ(get(r, "P.i0"), 1);
+  EXPECT_EQ(get(r, "P.i1"), 0);
+  EXPECT_EQ(get(r, "P.i2"), 0);  // active-low: a high line is FALSE
+  EXPECT_EQ(get(r, "P.i3"), 1);
+  EXPECT_EQ(value(4), 1);
+  EXPECT_EQ(value(5), 0);
+  EXPECT_EQ(value(6), 1);  // q2 FALSE on an active-low line: high
+  EXPECT_EQ(value(7), 0);  // q3 TRUE: low
 }
 
 TEST_F(GpioSim, OutputsStartAndEndInTheSafeState) {

@@ -21,6 +21,7 @@ struct GpioBackend::Request {
   std::vector<unsigned> offsets;
   std::vector<uint32_t> byte;   // image byte of each line
   std::vector<uint8_t> mask;    // and its bit
+  std::vector<int> invert;      // 1: active-low (inverted here, so it shares the request)
   std::vector<int> values, last;
   bool requested = false, written = false;
   std::string where;            // the first mapping's FILE:LINE:COL
@@ -38,8 +39,10 @@ std::string present_chips() {
   return list.empty() ? "this machine has no /dev/gpiochip*" : "chips here: " + list;
 }
 
+// The kernel's flags of a line's request. Active-low is not among them: plcfi inverts
+// those lines itself, so lines that differ only in it share one bulk request.
 int request_flags(const GpioPoint& p) {
-  int f = p.active_low ? GPIOD_LINE_REQUEST_FLAG_ACTIVE_LOW : 0;
+  int f = 0;
   switch (p.bias) {
     case GpioBias::AsIs: break;
     case GpioBias::Disabled: f |= GPIOD_LINE_REQUEST_FLAG_BIAS_DISABLE; break;
@@ -57,7 +60,6 @@ int request_flags(const GpioPoint& p) {
 std::string flag_text(int f) {
   std::string t;
   auto add = [&](const char* s) { t += std::string(t.empty() ? "" : ", ") + s; };
-  if (f & GPIOD_LINE_REQUEST_FLAG_ACTIVE_LOW) add("active-low");
   if (f & GPIOD_LINE_REQUEST_FLAG_BIAS_DISABLE) add("bias disabled");
   if (f & GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_UP) add("pull-up");
   if (f & GPIOD_LINE_REQUEST_FLAG_BIAS_PULL_DOWN) add("pull-down");
@@ -138,6 +140,7 @@ std::unique_ptr<GpioBackend> GpioBackend::open(const IoConfig& cfg, std::string*
       r.offsets.push_back(off);
       r.byte.push_back(bit / 8);
       r.mask.push_back(static_cast<uint8_t>(1u << (bit % 8)));
+      r.invert.push_back(p.active_low ? 1 : 0);
       uint32_t end = bit / 8 + 1;
       (output ? b->out_extent_ : b->in_extent_) = std::max(output ? b->out_extent_ : b->in_extent_, end);
       ++bit;
@@ -149,9 +152,12 @@ std::unique_ptr<GpioBackend> GpioBackend::open(const IoConfig& cfg, std::string*
     r.last.assign(r.offsets.size(), -1);
     if (r.output) {
       // Outputs come up in the safe state (all off unless io: safe_state says otherwise).
-      for (size_t i = 0; i < r.offsets.size(); ++i)
+      for (size_t i = 0; i < r.offsets.size(); ++i) {
+        int logical = 0;
         for (const auto& [ref, v] : cfg.safe_state)
-          if (ref.is_bit && ref.offset == r.byte[i] && (1u << ref.bit) == r.mask[i]) r.values[i] = v != 0;
+          if (ref.is_bit && ref.offset == r.byte[i] && (1u << ref.bit) == r.mask[i]) logical = v != 0;
+        r.values[i] = logical ^ r.invert[i];
+      }
     }
     gpiod_line_request_config rc{};
     rc.consumer = "plcfi";
@@ -202,7 +208,7 @@ bool GpioBackend::read(uint8_t* inputs, int64_t) {
       continue;
     }
     for (size_t i = 0; i < r.values.size(); ++i) {
-      if (r.values[i]) inputs[r.byte[i]] |= r.mask[i];
+      if (r.values[i] ^ r.invert[i]) inputs[r.byte[i]] |= r.mask[i];
       else inputs[r.byte[i]] &= static_cast<uint8_t>(~r.mask[i]);
     }
   }
@@ -216,7 +222,7 @@ bool GpioBackend::write(const uint8_t* outputs, int64_t, int64_t) {
     if (!r.output || !r.requested) continue;
     bool changed = false;
     for (size_t i = 0; i < r.values.size(); ++i) {
-      r.values[i] = (outputs[r.byte[i]] & r.mask[i]) ? 1 : 0;
+      r.values[i] = ((outputs[r.byte[i]] & r.mask[i]) ? 1 : 0) ^ r.invert[i];
       changed = changed || r.values[i] != r.last[i];
     }
     if (!changed) continue;  // the kernel holds the lines' values
@@ -236,6 +242,10 @@ std::vector<std::string> GpioBackend::describe() const {
   std::vector<std::string> out;
   for (const auto& r : requests_) {
     std::string f = flag_text(r->flags);
+    std::vector<unsigned> low;
+    for (size_t i = 0; i < r->offsets.size(); ++i)
+      if (r->invert[i]) low.push_back(r->offsets[i]);
+    if (!low.empty()) f += fmt::format("{}active-low {}", f.empty() ? "" : ", ", fmt::join(low, ","));
     out.push_back(fmt::format("{}: {} lines {} (one bulk request{})", r->label, r->output ? "output" : "input",
                               fmt::join(r->offsets, ","), f.empty() ? "" : ", " + f));
   }
