@@ -3,6 +3,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -217,12 +218,30 @@ namespace {
 
 bool is_bool(const rt::ImageRef& r) { return r.is_bit || (r.type && r.type->kind == st::TypeKind::Bool); }
 bool is_integer(const rt::ImageRef& r) { return !is_bool(r) && r.type && (r.type->is_integer() || r.type->is_bitstring()); }
+bool is_real(const rt::ImageRef& r) { return !r.is_bit && r.type && r.type->is_real() && (r.size == 4 || r.size == 8); }
+
+// A REAL/LREAL location's value from the bits ImageRef::get returns (the low 4 or 8 bytes).
+double real_from_bits(const rt::ImageRef& r, int64_t bits) {
+  if (r.size == 4) {
+    auto b = static_cast<uint32_t>(bits);
+    float f;
+    std::memcpy(&f, &b, 4);
+    return f;
+  }
+  double d;
+  std::memcpy(&d, &bits, 8);
+  return d;
+}
+
+// The value at a location as a number: integers as themselves, REAL/LREAL as reals.
+double value_at(const rt::ImageRef& r, int64_t raw) { return is_real(r) ? real_from_bits(r, raw) : static_cast<double>(raw); }
 
 // Base of all fault rules: one location, a value transform, clamping to the location's type.
 class FaultRule : public rt::OverlayRule {
  public:
-  FaultRule(const InjectionContext& ctx, std::string desc) : ref_(ctx.ref), baseline_(ctx.baseline), inject_ns_(ctx.inject_ns),
-                                                             desc_(std::move(desc)) {
+  FaultRule(const InjectionContext& ctx, std::string desc)
+      : ref_(ctx.ref), baseline_(value_at(ctx.ref, ctx.baseline)), inject_ns_(ctx.inject_ns), desc_(std::move(desc)),
+        real_(is_real(ctx.ref)) {
     if (is_bool(ref_)) {
       lo_ = 0;
       hi_ = 1;
@@ -235,6 +254,16 @@ class FaultRule : public rt::OverlayRule {
     }
   }
   void apply(uint8_t* dst, const uint8_t* src, int64_t now_ns) override {
+    if (real_) {  // analog values as REAL/LREAL: no rounding, no clamping (beyond the float range)
+      double v = transform(real_from_bits(ref_, ref_.get(src)), now_ns);
+      if (ref_.size == 4) {
+        auto f = static_cast<float>(v);
+        std::memcpy(dst + ref_.offset, &f, 4);
+      } else {
+        std::memcpy(dst + ref_.offset, &v, 8);
+      }
+      return;
+    }
     double v = transform(static_cast<double>(ref_.get(src)), now_ns);
     v = std::round(v);
     if (v < lo_) v = lo_;
@@ -248,9 +277,10 @@ class FaultRule : public rt::OverlayRule {
  protected:
   virtual double transform(double v, int64_t now_ns) = 0;
   rt::ImageRef ref_;
-  int64_t baseline_;
+  double baseline_;  // the value at the injection
   int64_t inject_ns_;
   std::string desc_;
+  bool real_;
   double lo_ = 0, hi_ = 0;
 };
 
@@ -304,7 +334,7 @@ class DelayRule final : public FaultRule {
   DelayRule(const InjectionContext& c, std::string d, int64_t delay_ns) : FaultRule(c, std::move(d)), delay_(delay_ns) {
     int64_t tick = c.tick_ns > 0 ? c.tick_ns : 1'000'000;
     ring_.resize(static_cast<size_t>(delay_ns / tick) + 4);
-    current_ = static_cast<double>(baseline_);
+    current_ = baseline_;
   }
   double transform(double v, int64_t now) override {
     if (count_ == ring_.size()) pop();  // ticks shorter than planned: drop the oldest
@@ -345,7 +375,7 @@ class IntermittentRule final : public FaultRule {
     } else {
       active = static_cast<double>(t % span_) < p_ * static_cast<double>(span_);
     }
-    return active ? static_cast<double>(baseline_) : v;
+    return active ? baseline_ : v;
   }
 
  private:
@@ -372,8 +402,8 @@ std::unique_ptr<rt::OverlayRule> make_rule(const FaultSpec& f, const InjectionCo
     return nullptr;
   }
   const bool b = is_bool(r);
-  if (!b && !is_integer(r)) {
-    *err = fmt::format("fault '{}': {} holds neither a BOOL nor an integer value", f.text, at);
+  if (!b && !is_integer(r) && !is_real(r)) {
+    *err = fmt::format("fault '{}': {} holds no BOOL, integer or REAL value", f.text, at);
     return nullptr;
   }
   switch (f.kind) {
@@ -402,8 +432,8 @@ std::unique_ptr<rt::OverlayRule> make_rule(const FaultSpec& f, const InjectionCo
     default:
       break;
   }
-  const std::string base = b ? (ctx.baseline ? "TRUE" : "FALSE") : std::to_string(ctx.baseline);
-  const double baseline = static_cast<double>(ctx.baseline);
+  const double baseline = value_at(ctx.ref, ctx.baseline);
+  const std::string base = b ? (ctx.baseline ? "TRUE" : "FALSE") : is_real(ctx.ref) ? fmt_num(baseline) : std::to_string(ctx.baseline);
   switch (f.kind) {
     case Kind::StuckAt:
       return std::make_unique<ConstantRule>(ctx, fmt::format("{}: stuck at {}", at, b ? (f.value ? "TRUE" : "FALSE") : fmt_num(f.value)),

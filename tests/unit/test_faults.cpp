@@ -3,6 +3,8 @@
 // actuator faults change what reaches the plant but not the program's variables.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include <cmath>
 #include <numeric>
 
@@ -366,6 +368,83 @@ TEST_F(FaultFixture, RulesDescribeThemselves) {
   inject("stuck", "%IW2");
   ASSERT_EQ(rt_->input_overlay().rules().size(), 1u);
   EXPECT_EQ(rt_->input_overlay().rules()[0]->describe(), "%IW2: stuck at 42 (its value at the injection)");
+}
+
+}  // namespace
+}  // namespace plcfi::faults
+
+// ------------------------------------------------------------------ REAL analog values
+
+namespace plcfi::faults {
+namespace {
+
+// Delivers a REAL at %ID1 (bytes 4..7).
+class RealBackend final : public rt::IoBackend {
+ public:
+  const std::string& name() const override { return name_; }
+  uint32_t input_extent() const override { return 8; }
+  uint32_t output_extent() const override { return 0; }
+  bool read(uint8_t* in, int64_t) override {
+    std::memcpy(in + 4, &level, 4);
+    return true;
+  }
+  bool write(const uint8_t*, int64_t, int64_t) override { return true; }
+  void reset(uint64_t) override {}
+  const std::string& last_error() const override { return name_; }
+  std::string name_ = "real";
+  float level = 0;
+};
+
+// A REAL sensor is faulted by value (offset, gain, frozen, drift, open wire), not by its bits.
+TEST(FaultReal, AnalogRealSensorsAreFaultedByValue) {
+  auto b = st::build_sources({{"r.st", "PROGRAM P\nVAR\n  level AT %ID1 : REAL;\n  seen : REAL;\nEND_VAR\nseen := level;\nEND_PROGRAM\n"}},
+                             st::CompileOptions{});
+  ASSERT_TRUE(b->ok()) << b->diags.render_all();
+  rt::Schedule sched;
+  std::string err;
+  ASSERT_TRUE(sched.single_program(*b->app, "P", 10'000'000, &err)) << err;
+  RealBackend plant;
+  rt::Runtime r(*b->app, sched, &plant);
+  r.cold_restart(1);
+  auto seen = *st::resolve(*b->app, "P.seen", &err);
+  rt::ImageRef ref;
+  ASSERT_TRUE(rt::parse_image_ref(*b->app, "%ID1", &ref, &err)) << err;
+  ASSERT_EQ(ref.type->name, "REAL");
+  auto inject = [&](const char* text) {
+    FaultSpec f;
+    uint32_t col = 0;
+    ASSERT_TRUE(parse_fault(text, &f, &err, &col)) << err;
+    InjectionContext ctx;
+    ctx.ref = ref;
+    ctx.baseline = ref.get(r.raw_inputs());
+    ctx.inject_ns = r.now();
+    ctx.tick_ns = 10'000'000;
+    auto rule = make_rule(f, ctx, &err);
+    ASSERT_TRUE(rule) << err;
+    r.input_overlay().clear();
+    r.input_overlay().add(std::move(rule));
+  };
+  auto scan = [&](float v) {
+    plant.level = v;
+    r.scan();
+    return st::read_real(r.machine(), seen);
+  };
+  EXPECT_EQ(scan(10.25f), 10.25);
+  inject("offset(1.5)");
+  EXPECT_EQ(scan(10.25f), 11.75);
+  inject("gain(2)");
+  EXPECT_EQ(scan(10.25f), 20.5);
+  inject("frozen");
+  EXPECT_EQ(scan(3.0f), 10.25);  // the value at the injection, whatever the plant delivers
+  inject("open_wire(-1.5)");
+  EXPECT_EQ(scan(3.0f), -1.5);
+  scan(4.0f);
+  inject("drift(0.5/s)");
+  double v = 0;
+  for (int i = 0; i < 100; ++i) v = scan(4.0f);  // one second later
+  EXPECT_NEAR(v, 4.5, 0.01);
+  r.input_overlay().clear();
+  EXPECT_EQ(scan(7.0f), 7.0);
 }
 
 }  // namespace
