@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <random>
 
 #include <cmath>
 #include <numeric>
@@ -445,6 +446,39 @@ TEST(FaultReal, AnalogRealSensorsAreFaultedByValue) {
   EXPECT_NEAR(v, 4.5, 0.01);
   r.input_overlay().clear();
   EXPECT_EQ(scan(7.0f), 7.0);
+}
+
+}  // namespace
+}  // namespace plcfi::faults
+
+namespace plcfi::faults {
+namespace {
+
+// Garbage never crashes the parser (nor trips the sanitizers), every error column lies
+// within the text, and what it accepts reads back to the same canonical form.
+TEST(FaultParse, RandomTextNeverCrashesAndColumnsStayInTheText) {
+  const std::string alphabet = "stuck_aoffsetgindrlymw()0123456789.,-+#/ TF";
+  std::mt19937_64 rng(11);
+  int accepted = 0;
+  for (int i = 0; i < 5000; ++i) {
+    std::string text;
+    size_t len = rng() % 24;
+    for (size_t k = 0; k < len; ++k) text += alphabet[rng() % alphabet.size()];
+    if (i % 3 == 0) text = std::string(i % 2 ? "delay(" : "stuck_at(") + text;
+    FaultSpec f;
+    std::string err;
+    uint32_t col = 0;
+    if (parse_fault(text, &f, &err, &col)) {
+      ++accepted;
+      FaultSpec again;
+      EXPECT_TRUE(parse_fault(f.text, &again, &err, &col)) << text << " -> " << f.text << ": " << err;
+      EXPECT_EQ(f.text, again.text);
+    } else {
+      EXPECT_LE(col, text.size()) << text << ": " << err;
+      EXPECT_FALSE(err.empty()) << text;
+    }
+  }
+  EXPECT_LT(accepted, 5000);
 }
 
 }  // namespace
