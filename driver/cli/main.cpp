@@ -1,6 +1,7 @@
 // The plcfi executable: subcommand dispatch and option parsing. Each command is thin and
 // delegates to the libraries. Exit status: 0 success, 1 a test or check failed,
 // 2 bad usage or input.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -24,13 +25,13 @@ struct Command {
 const std::vector<Command>& commands() {
   static const std::vector<Command> k = {
       {"check", "compile ST files and print diagnostics", plcfi::cli::cmd_check},
-      {"run", "run ST programs in virtual time and print variables", plcfi::cli::cmd_run},
+      {"run", "run ST programs in virtual time and print variables, or on real I/O in real time", plcfi::cli::cmd_run},
       {"test", "run ST unit-test files", plcfi::cli::cmd_test},
       {"disasm", "print the bytecode of ST files with their source lines", plcfi::cli::cmd_disasm},
       {"sim", "run a PLC program on a plant model in virtual time", plcfi::cli::cmd_sim},
       {"edtl", "check EDTL requirements on a recorded trace (edtl check REQS TRACE)", plcfi::cli::cmd_edtl},
       {"generate", "generate the prioritized fault-injection test cases of a campaign (TSD + FMEA)", plcfi::cli::cmd_generate},
-      {"campaign", "run a passive fault-injection campaign on the plant model", plcfi::cli::cmd_campaign},
+      {"campaign", "run a passive fault-injection campaign on the plant model or, armed, on real I/O", plcfi::cli::cmd_campaign},
       {"plant-server", "serve a plant model in real time over Modbus TCP (bench rehearsal)", plcfi::cli::cmd_plant_server},
   };
   return k;
@@ -39,7 +40,10 @@ const std::vector<Command>& commands() {
 void usage(std::ostream& os) {
   os << "usage: plcfi <command> [options] [files...]\n\n"
         "plcfi tests IEC 61131-3 Structured Text programs under faults.\n\ncommands:\n";
-  for (const auto& c : commands()) os << "  " << c.name << std::string(10 - std::string(c.name).size(), ' ') << c.summary << "\n";
+  size_t width = 0;
+  for (const auto& c : commands()) width = std::max(width, std::string(c.name).size());
+  for (const auto& c : commands())
+    os << "  " << c.name << std::string(width + 2 - std::string(c.name).size(), ' ') << c.summary << "\n";
   os << "\n'plcfi <command> --help' describes a command's options.\n";
 }
 
