@@ -4,7 +4,7 @@
 // monitor with a direct implementation on random traces.
 #include <gtest/gtest.h>
 
-#include "../support/temp_files.hpp"
+#include "../../support/temp_files.hpp"
 
 #include <filesystem>
 #include <fstream>
