@@ -340,8 +340,8 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
       r.write_safe_outputs();
     }
   } safe_exit{runtime};
-  rt::RealTimePacer pacer(cb.schedule.tick_ns());
-  if (opt.realtime) pacer.start();
+  rt::ScanLoop loop(runtime, opt.realtime, opt.signals, opt.io_lost);
+  loop.start();
   PassiveDriver driver(cb, opt);
   runtime.add_hooks(&driver);
 
@@ -371,7 +371,6 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
   }
   pr.executions = out->executions.size();
 
-  const int64_t tick = cb.schedule.tick_ns();
   int64_t next_progress = pr.campaign_ns + 1'000'000'000;
   while (true) {
     if (driver.all_done()) {
@@ -388,28 +387,15 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
     driver.begin_run(pr.run);
     bool search_over = false;
     while (!driver.done()) {
-      if (opt.stop && opt.stop()) {
-        out->end_reason = "interrupted by a signal";
+      if (rt::LoopEnd end = loop.check_stop(); end != rt::LoopEnd::None) {
+        out->end_reason = end == rt::LoopEnd::Signal ? "interrupted by a signal" : loop.end_reason();
         out->interrupted = true;
         break;
       }
-      if (opt.io_lost) {
-        std::string lost = opt.io_lost();
-        if (!lost.empty()) {
-          out->end_reason = "communication lost: " + lost;
-          out->interrupted = true;
-          break;
-        }
-      }
-      int64_t woke = 0;
-      if (opt.realtime) {
-        pacer.wait_next();
-        woke = rt::RealTimePacer::monotonic_ns();
-      }
-      runtime.scan();
-      if (opt.realtime) pacer.record_exec(rt::RealTimePacer::monotonic_ns() - woke);
+      const int64_t before = runtime.now();
+      loop.scan();
       ++pr.scans;
-      pr.campaign_ns += tick;
+      pr.campaign_ns += runtime.now() - before;  // one tick, or more after an overrun on the bench
       if (!driver.active()) {
         // Not testing: the run searches for a precondition on an untested path.
         if (runtime.now() >= c.search_window_ns || runtime.stopped()) {
@@ -449,11 +435,9 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
     }
   }
   runtime.remove_hooks(&driver);
-  if (opt.realtime) {
-    out->realtime = pacer.properties();
-    out->realtime_text = fmt::format("wake latency   {}\nexecution      {}\noverruns       {} of {} cycles of {} ms",
-                                     pacer.wake_latency().summary(), pacer.exec_time().summary(), pacer.overruns(),
-                                     pacer.wake_latency().count(), static_cast<double>(pacer.period_ns()) / 1e6);
+  if (loop.paced()) {
+    out->realtime = loop.pacer().properties();
+    for (const auto& line : loop.figures()) out->realtime_text += (out->realtime_text.empty() ? "" : "\n") + line;
   }
   std::vector<bool> seen(cb.cases.size(), false);
   for (const auto& e : out->executions) seen[e.case_index] = true;

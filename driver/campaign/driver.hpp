@@ -15,6 +15,7 @@
 #include "generate.hpp"
 #include "native/native.hpp"
 #include "runtime/backend.hpp"
+#include "runtime/realtime.hpp"
 
 namespace plcfi::campaign {
 
@@ -53,9 +54,9 @@ struct DriverOptions {
   std::function<void(const Execution&, const Progress&)> on_verdict;
   std::function<void(const Progress&)> on_progress;  // about every simulated second
   // Real I/O: scans paced on real-time deadlines; the run ends (faults withdrawn, safe
-  // outputs written) when stop() says so or io_lost() names a lost device.
+  // outputs written) on a stop signal or when io_lost() names a lost device.
   bool realtime = false;
-  std::function<bool()> stop;
+  const rt::StopSignals* signals = nullptr;
   std::function<std::string()> io_lost;
   std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
   const st::NativeCode* native = nullptr;  // run program, preconditions and monitors natively

@@ -5,6 +5,7 @@
 #include <tuple>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include <unistd.h>
 
@@ -14,23 +15,19 @@
 #include "campaign/driver.hpp"
 #include "campaign/generate.hpp"
 #include "commands.hpp"
+#include "options.hpp"
 #include "json.hpp"
 #include "report/junit.hpp"
 #include "report/puml.hpp"
 
 #include "io/bench/bench_io.hpp"
-#include <atomic>
 #include <sstream>
-#include <csignal>
 
 namespace po = boost::program_options;
 
 namespace plcfi::cli {
 
 namespace {
-
-std::atomic<bool> g_campaign_stop{false};
-void on_campaign_signal(int) { g_campaign_stop.store(true); }
 
 using campaign::CampaignBuild;
 using campaign::TestCase;
@@ -216,21 +213,21 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("resume", "finish a campaign whose journal is in the output folder (no case runs twice)")
       ("junit", po::value<std::string>(), "write JUnit XML")
       ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
-      ("seed", po::value<uint64_t>(), "seed instead of the campaign's")
+      ("seed", po::value<Count>(), "seed instead of the campaign's")
       ("no-vcd", "no VCD trace per test")
       ("quiet", "no live progress line")
       ("io", po::value<std::string>(), "run on real I/O: a file with an io: section (instead of the campaign's io: or plant)")
       ("arm", "allow fault injection on real I/O (required with io:)")
       ("realtime", "pace the scans in real time (always on with real I/O); report wake latency, execution time, overruns")
-      ("rt-priority", po::value<int>()->default_value(0), "with real time: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
-      ("cpu", po::value<int>()->default_value(-1), "with real time: pin the scan thread to this CPU")
+      ("rt-priority", po::value<RtPriority>()->default_value(RtPriority{0}, "0"), "with real time: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
+      ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with real time: pin the scan thread to this CPU")
       ("native", "run program, preconditions and monitors through the native tier");
   po::variables_map vm;
   if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
   CampaignBuild cb;
   std::vector<std::string> programs;
   if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
-  uint64_t seed = vm.count("seed") ? vm["seed"].as<uint64_t>() : 0;
+  uint64_t seed = vm.count("seed") ? vm["seed"].as<Count>().value : 0;
   if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, vm.count("seed") ? &seed : nullptr, &cb))
     return 2;
   const auto& c = cb.spec;
@@ -272,13 +269,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
   std::string io_path = vm.count("io") ? vm["io"].as<std::string>() : c.io;
   bool ran = false;
   std::vector<std::string> io_report;
-  RealtimeOptions rto;
-  rto.priority = vm["rt-priority"].as<int>();
-  rto.cpu = vm["cpu"].as<int>();
-  if (rto.priority < 0 || rto.priority > 99) {
-    std::cerr << "plcfi campaign: --rt-priority must be 0..99\n";
-    return 2;
-  }
+  rt::RealtimeOptions rto;
+  std::optional<rt::StopSignals> signals;  // installed for real-time runs only
+  rto.priority = static_cast<int>(vm["rt-priority"].as<RtPriority>().value);
+  rto.cpu = static_cast<int>(vm["cpu"].as<CpuIndex>().value);
   if (!io_path.empty()) {
     if (!vm.count("arm")) {
       std::cerr << "plcfi campaign: refusing to inject faults on real I/O (" << io_path
@@ -296,12 +290,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
       std::cerr << err << "\n";
       return 2;
     }
-    std::signal(SIGINT, on_campaign_signal);
-    std::signal(SIGTERM, on_campaign_signal);
-    std::signal(SIGPIPE, SIG_IGN);
+    signals.emplace();
     opt.realtime = true;
-    realtime_setup(rto, "plcfi campaign");
-    opt.stop = [] { return g_campaign_stop.load(); };
+    warn_realtime_setup(rto, "plcfi campaign");
+    opt.signals = &*signals;
     auto* bench = backend.get();
     opt.io_lost = [bench] { return bench->lost(); };
     opt.safe_state = io_cfg.safe_state;
@@ -313,11 +305,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
   } else {
     if (vm.count("realtime")) {
       // The simulated plant at the speed of the real one: a rehearsal of the bench run.
-      std::signal(SIGINT, on_campaign_signal);
-      std::signal(SIGTERM, on_campaign_signal);
+      signals.emplace();
       opt.realtime = true;
-      opt.stop = [] { return g_campaign_stop.load(); };
-      realtime_setup(rto, "plcfi campaign");
+      opt.signals = &*signals;
+      warn_realtime_setup(rto, "plcfi campaign");
     }
     ran = campaign::run_campaign(cb, opt, &res, &err);
   }

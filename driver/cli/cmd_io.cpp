@@ -1,23 +1,17 @@
-// plcfi plant-server: a plant model in real time behind a Modbus TCP server.
-#include <atomic>
-#include <csignal>
-#include <cstring>
+// plcfi run --io (the program on real I/O, paced in real time) and plcfi plant-server (a
+// plant model in real time behind a Modbus TCP server).
 #include <iostream>
-
-#include <fcntl.h>
-#include <sched.h>
-#include <unistd.h>
-#include <sys/mman.h>
-#include <sys/prctl.h>
 
 #include <boost/program_options.hpp>
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "engine.hpp"
 #include "plant_model/plant.hpp"
 #include "report/junit.hpp"
 #include "runtime/clock.hpp"
+#include "runtime/realtime.hpp"
 #include "runtime/runtime.hpp"
 #include "runtime/schedule.hpp"
 
@@ -30,46 +24,8 @@ namespace po = boost::program_options;
 
 namespace plcfi::cli {
 
-namespace {
-std::atomic<bool> g_stop{false};
-std::atomic<int> g_signal{0};
-void on_signal(int s) {
-  g_signal.store(s);
-  g_stop.store(true);
-}
-
-}  // namespace
-
-// Real-time set-up of the scan thread; each step that fails is reported and skipped (a
-// bench run without privileges still runs, with worse latency).
-void realtime_setup(const RealtimeOptions& o, const char* who) {
-  prctl(PR_SET_TIMERSLACK, 1UL, 0, 0, 0);
-  // Keep the CPUs out of deep idle states while the run lasts (PM QoS, as cyclictest
-  // does): the request holds while the file stays open, so it is never closed here.
-  static int dma_latency = -1;
-  if (dma_latency < 0) {
-    dma_latency = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
-    int32_t zero = 0;
-    if (dma_latency >= 0 && ::write(dma_latency, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
-      ::close(dma_latency);
-      dma_latency = -1;
-    }
-  }
-  if (o.lock_memory && mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-    std::cerr << who << ": warning: mlockall: " << std::strerror(errno) << " (page faults may add latency)\n";
-  if (o.cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(o.cpu, &set);
-    if (sched_setaffinity(0, sizeof set, &set) != 0)
-      std::cerr << who << ": warning: CPU affinity " << o.cpu << ": " << std::strerror(errno) << "\n";
-  }
-  if (o.priority > 0) {
-    sched_param sp{};
-    sp.sched_priority = o.priority;
-    if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0)
-      std::cerr << who << ": warning: SCHED_FIFO priority " << o.priority << ": " << std::strerror(errno) << "\n";
-  }
+void warn_realtime_setup(const rt::RealtimeOptions& o, const char* who) {
+  for (const auto& w : rt::realtime_setup(o)) std::cerr << who << ": warning: " << w << "\n";
 }
 
 int run_with_io(const st::Application& app, const rt::Schedule& sched, const std::string& io_path, const RunIoOptions& o,
@@ -96,49 +52,21 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
     runtime.write_safe_outputs();
     return 2;
   }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
-  std::signal(SIGPIPE, SIG_IGN);
-  if (o.realtime) realtime_setup(o.rt, "plcfi run");
-  rt::RealTimePacer pacer(sched.tick_ns());
-  pacer.start();
-  uint64_t scans = 0;
-  int status = 0;
-  std::string why = "done";
+  rt::StopSignals signals;
+  if (o.realtime) warn_realtime_setup(o.rt, "plcfi run");
+  rt::ScanLoop loop(runtime, o.realtime, &signals, [&backend] { return backend ? backend->lost() : std::string(); });
   const int64_t t0 = rt::RealTimePacer::monotonic_ns();
-  while (true) {
-    if (g_stop.load()) {
-      why = g_signal.load() == SIGTERM ? "SIGTERM" : "SIGINT";
-      break;
-    }
-    if (o.cycles && scans >= o.cycles) break;
-    if (o.duration_ns && rt::RealTimePacer::monotonic_ns() - t0 >= o.duration_ns) break;
-    if (o.realtime) pacer.wait_next();
-    int64_t a = rt::RealTimePacer::monotonic_ns();
-    rt::ScanStatus st = runtime.scan();
-    pacer.record_exec(rt::RealTimePacer::monotonic_ns() - a);
-    ++scans;
-    if (st == rt::ScanStatus::Trapped) {
-      why = "trap: " + runtime.stop_reason();
-      status = 1;
-      break;
-    }
-    std::string lost = backend ? backend->lost() : "";
-    if (!lost.empty()) {
-      why = "communication lost: " + lost;
-      status = 1;
-      break;
-    }
-  }
+  rt::LoopEnd end = loop.run(o.cycles, o.duration_ns);
+  int status = end == rt::LoopEnd::Trapped || end == rt::LoopEnd::CommunicationLost ? 1 : 0;
+  const std::string& why = loop.end_reason();
+  const uint64_t scans = loop.scans();
   // Every way out: the safe output state reaches the devices before they are closed.
   runtime.write_safe_outputs();
   if (backend) backend->close();
   std::cout << fmt::format("plcfi run: {} scans of {} ms over {}, ended: {}; outputs written to the safe state{}\n", scans,
                            static_cast<double>(sched.tick_ns()) / 1e6, backend ? cfg.path : "no I/O", why,
                            cfg.safe_state.empty() ? " (all off)" : fmt::format(" (all off but {})", cfg.safe_state.size()));
-  if (o.realtime)
-    std::cout << fmt::format("  wake latency   {}\n  execution      {}\n  overruns       {}\n", pacer.wake_latency().summary(),
-                             pacer.exec_time().summary(), pacer.overruns());
+  for (const auto& line : loop.figures()) std::cout << "  " << line << "\n";
   if (backend)
     for (const auto& line : backend->report()) std::cout << "  " << line << "\n";
   report(runtime.machine(), status);
@@ -155,8 +83,8 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
     }
     jc.properties.emplace_back("scans", std::to_string(scans));
     jc.properties.emplace_back("ended", why);
-    if (o.realtime)
-      for (const auto& p : pacer.properties()) suite.properties.push_back(p);
+    if (loop.paced())
+      for (const auto& p : loop.pacer().properties()) suite.properties.push_back(p);
     if (backend) {
       int n = 0;
       for (const auto& line : backend->report()) suite.properties.emplace_back(fmt::format("io_{}", n++), line);
@@ -178,7 +106,7 @@ int cmd_plant_server(const std::vector<std::string>& args) {
       ("listen", po::value<std::string>()->default_value("127.0.0.1:1502"), "address and port (HOST:PORT, [V6]:PORT); loopback by default")
       ("tick", po::value<std::string>()->default_value("1ms"), "plant step in real time")
       ("duration", po::value<std::string>(), "stop after this long (default: until SIGINT/SIGTERM)")
-      ("seed", po::value<uint64_t>()->default_value(1), "seed of the plant's random variation")
+      ("seed", po::value<Count>()->default_value(Count{1}, "1"), "seed of the plant's random variation")
       ("help,h", "show this help");
   po::variables_map vm;
   po::store(po::command_line_parser(args).options(desc).run(), vm);
@@ -212,6 +140,13 @@ int cmd_plant_server(const std::vector<std::string>& args) {
     opt.host = listen.substr(0, colon);
     opt.port = listen.substr(colon + 1);
   }
+  // libmodbus takes the port as text and lets the resolver wrap it (99999 served on 34463).
+  bool neg = false;
+  uint64_t port = 0;
+  if (!parse_whole(opt.port, &neg, &port) || neg || port < 1 || port > 65535) {
+    std::cerr << "plcfi plant-server: --listen: port '" << opt.port << "' is not a whole number from 1 to 65535\n";
+    return 2;
+  }
   if (!rt::parse_duration(vm["tick"].as<std::string>(), &opt.tick_ns, &err) || opt.tick_ns <= 0) {
     std::cerr << "plcfi plant-server: --tick: " << (err.empty() ? "must be positive" : err) << "\n";
     return 2;
@@ -220,21 +155,19 @@ int cmd_plant_server(const std::vector<std::string>& args) {
     std::cerr << "plcfi plant-server: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
     return 2;
   }
-  opt.seed = vm["seed"].as<uint64_t>();
+  opt.seed = vm["seed"].as<Count>().value;
   auto plant = plant::make_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
   if (!plant) {
     std::cerr << "plcfi plant-server: " << err << "\n";
     return 2;
   }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
-  std::signal(SIGPIPE, SIG_IGN);  // a client that disappears mid-answer is not our end
+  rt::StopSignals signals;  // SIGPIPE too: a client that disappears mid-answer is not our end
   io::PlantServerStats stats;
   auto listening = [](const io::PlantServerOptions& o) {
     std::cout << fmt::format("plcfi plant-server: listening on {}:{}, plant step {} us\n", o.host, o.port, o.tick_ns / 1000)
               << std::flush;
   };
-  bool ok = io::serve_plant(*plant, opt, g_stop, &stats, &err, listening);
+  bool ok = io::serve_plant(*plant, opt, [&signals] { return signals.requested(); }, &stats, &err, listening);
   std::cout << fmt::format("plcfi plant-server: {} plant steps ({} late), {} connection(s), {} request(s)\n", stats.steps,
                            stats.late_steps, stats.connections, stats.requests);
   std::string s;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "engine.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "monitor/edtl.hpp"
@@ -119,7 +120,7 @@ int cmd_sim(const std::vector<std::string>& args) {
       ("program", po::value<std::vector<std::string>>()->multitoken(), "ST files of the program (also accepted as plain arguments)")
       ("plant", po::value<std::string>()->default_value("stamping"), "plant model")
       ("plant-config", po::value<std::string>(), "plant parameters (YAML)")
-      ("seed", po::value<uint64_t>()->default_value(1), "seed of the plant's random variation")
+      ("seed", po::value<Count>()->default_value(Count{1}, "1"), "seed of the plant's random variation")
       ("duration", po::value<std::string>()->default_value("1h"), "simulated time, e.g. 90s, 10m, 1h")
       ("cycle-time", po::value<std::string>()->default_value("10ms"), "cycle time when the program has no CONFIGURATION")
       ("vcd", po::value<std::string>(), "write a VCD trace")
@@ -278,7 +279,7 @@ int cmd_sim(const std::vector<std::string>& args) {
     runtime.add_hooks(monitor_hook.get());
   }
 
-  uint64_t seed = vm["seed"].as<uint64_t>();
+  uint64_t seed = vm["seed"].as<Count>().value;
   runtime.cold_restart(seed);
   uint64_t scans = static_cast<uint64_t>(duration / sched.tick_ns());
   auto t0 = std::chrono::steady_clock::now();

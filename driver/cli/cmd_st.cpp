@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "options.hpp"
 #include "native/native.hpp"
 #include "json.hpp"
 #include "engine.hpp"
@@ -121,19 +122,19 @@ int cmd_run(const std::vector<std::string>& args) {
   po::options_description desc("plcfi run: run ST programs in virtual time (the configuration's tasks, or one program)");
   desc.add_options()
       ("program", po::value<std::string>(), "program instance or type to run (without a CONFIGURATION)")
-      ("cycles", po::value<uint64_t>()->default_value(1), "number of base-tick cycles to run")
+      ("cycles", po::value<Count>()->default_value(Count{1}, "1"), "number of base-tick cycles to run")
       ("cycle-time", po::value<std::string>()->default_value("10ms"), "cycle time for a single program (e.g. 10ms)")
       ("set", po::value<std::vector<std::string>>(), "PATH=VALUE before the first cycle (repeatable)")
       ("print", po::value<std::vector<std::string>>(), "PATH to print at the end (repeatable)")
       ("json", "print the result as JSON")
       ("coverage", "print branch coverage per file")
-      ("budget", po::value<uint64_t>()->default_value(10'000'000), "loop iterations allowed per program call (watchdog)")
+      ("budget", po::value<Count>()->default_value(Count{10'000'000}, "10000000"), "loop iterations allowed per program call (watchdog)")
       ("native", "run the program through the native tier (generated C++, compiled by the system's compiler)")
-      ("io", po::value<std::string>(), "exchange the image with real I/O (a file with an io: section: Modbus devices and mappings)")
-      ("realtime", "pace the scans on absolute real-time deadlines and report wake latency (with or without --io)")
+      ("io", po::value<std::string>(), "exchange the image with real I/O (a file with an io: section: Modbus/GPIO devices and mappings), paced in real time")
+      ("realtime", "pace the scans on absolute real-time deadlines and report wake latency (always on with --io)")
       ("duration", po::value<std::string>(), "with --io or --realtime: run this long (e.g. 10s); SIGINT/SIGTERM also end the run")
-      ("rt-priority", po::value<int>()->default_value(0), "with --realtime: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
-      ("cpu", po::value<int>()->default_value(-1), "with --realtime: pin the scan thread to this CPU")
+      ("rt-priority", po::value<RtPriority>()->default_value(RtPriority{0}, "0"), "with --realtime: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
+      ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with --realtime: pin the scan thread to this CPU")
       ("junit", po::value<std::string>(), "with --io or --realtime: JUnit XML with the wake latency, execution time and overruns as properties");
   po::variables_map vm;
   if (!parse(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE] [--realtime [--rt-priority N] [--cpu N]] [--duration T] [--junit F]")) return 0;
@@ -165,23 +166,21 @@ int cmd_run(const std::vector<std::string>& args) {
   if (vm.count("io") || vm.count("realtime")) {
     RunIoOptions o;
     o.native = native.get();
-    o.realtime = vm.count("realtime") > 0;
-    o.rt.priority = vm["rt-priority"].as<int>();
-    o.rt.cpu = vm["cpu"].as<int>();
+    // Real I/O is always paced: unpaced scans would hammer the devices (and the plant)
+    // millions of times a second.
+    o.realtime = vm.count("realtime") > 0 || vm.count("io") > 0;
+    o.rt.priority = static_cast<int>(vm["rt-priority"].as<RtPriority>().value);
+    o.rt.cpu = static_cast<int>(vm["cpu"].as<CpuIndex>().value);
     if (vm.count("junit")) o.junit = vm["junit"].as<std::string>();
-    if (o.rt.priority < 0 || o.rt.priority > 99) {
-      std::cerr << "plcfi run: --rt-priority must be 0..99\n";
-      return 2;
-    }
     if (vm.count("duration") && (!rt::parse_duration(vm["duration"].as<std::string>(), &o.duration_ns, &err) || o.duration_ns <= 0)) {
       std::cerr << "plcfi run: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
       return 2;
     }
-    if (!vm["cycles"].defaulted() || !vm.count("duration")) o.cycles = vm["cycles"].as<uint64_t>();
+    if (!vm["cycles"].defaulted() || !vm.count("duration")) o.cycles = vm["cycles"].as<Count>().value;
     std::vector<std::string> sets = vm.count("set") ? vm["set"].as<std::vector<std::string>>() : std::vector<std::string>{};
     std::vector<std::string> prints = vm.count("print") ? vm["print"].as<std::vector<std::string>>() : std::vector<std::string>{};
     auto setup = [&](st::Machine& mm) {
-      mm.set_budget(vm["budget"].as<uint64_t>());
+      mm.set_budget(vm["budget"].as<Count>().value);
       for (const auto& sv : sets) {
         auto eq = sv.find('=');
         auto h = eq == std::string::npos ? std::nullopt : st::resolve(app, sv.substr(0, eq), &err);
@@ -206,7 +205,7 @@ int cmd_run(const std::vector<std::string>& args) {
     return run_with_io(app, sched, vm.count("io") ? vm["io"].as<std::string>() : "", o, setup, report);
   }
   st::Machine m(app);
-  m.set_budget(vm["budget"].as<uint64_t>());
+  m.set_budget(vm["budget"].as<Count>().value);
   m.set_native(native.get());
   if (vm.count("set")) {
     for (const auto& s : vm["set"].as<std::vector<std::string>>()) {
@@ -233,7 +232,7 @@ int cmd_run(const std::vector<std::string>& args) {
       prints.push_back(*h);
     }
   }
-  uint64_t cycles = vm["cycles"].as<uint64_t>();
+  uint64_t cycles = vm["cycles"].as<Count>().value;
   int status = 0;
   std::string trap_text;
   uint64_t done = 0;
@@ -273,7 +272,7 @@ int cmd_test(const std::vector<std::string>& args) {
   desc.add_options()
       ("junit", po::value<std::string>(), "write JUnit XML to this file")
       ("coverage", "print branch coverage of the sources")
-      ("budget", po::value<uint64_t>()->default_value(100'000'000), "loop iterations allowed per test phase (watchdog)")
+      ("budget", po::value<Count>()->default_value(Count{100'000'000}, "100000000"), "loop iterations allowed per test phase (watchdog)")
       ("native", "run the tests through the native tier (generated C++, compiled by the system's compiler)");
   po::variables_map vm;
   if (!parse(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage]")) return 0;
@@ -291,7 +290,7 @@ int cmd_test(const std::vector<std::string>& args) {
   if (vm.count("native") && !(native = load_native(*b->app, "plcfi test"))) return 2;
   m.set_native(native.get());
   st::TestRunOptions ro;
-  ro.budget = vm["budget"].as<uint64_t>();
+  ro.budget = vm["budget"].as<Count>().value;
   auto results = st::run_tests(*b->app, m, ro);
   size_t passed = 0, failed = 0;
   std::string current;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "runtime/realtime.hpp"
 #include "runtime/schedule.hpp"
 #include "vm/program.hpp"
 #include "native/native.hpp"
@@ -28,21 +29,16 @@ int cmd_plant_server(const std::vector<std::string>& args);
 // on stderr as `who: native tier: ...`; nullptr after printing the error.
 std::unique_ptr<st::NativeCode> load_native(const st::Application& app, const char* who);
 
-// `plcfi run --io`: the program on real I/O (Modbus), optionally paced in real time.
-struct RealtimeOptions {
-  int priority = 0;  // SCHED_FIFO priority (0: keep the normal scheduler)
-  int cpu = -1;      // CPU affinity (-1: any)
-  bool lock_memory = true;
-};
-// Timer slack, PM QoS, mlockall, affinity, SCHED_FIFO for the calling thread; a step that
-// fails is reported on stderr (prefixed by `who`) and skipped.
-void realtime_setup(const RealtimeOptions& o, const char* who);
+// The platform set-up of the scan thread (rt::realtime_setup), its warnings on stderr
+// prefixed by `who`.
+void warn_realtime_setup(const rt::RealtimeOptions& o, const char* who);
 
+// `plcfi run --io`: the program on real I/O, paced in real time.
 struct RunIoOptions {
   uint64_t cycles = 0;      // 0: no limit
   int64_t duration_ns = 0;  // 0: no limit
   bool realtime = false;
-  RealtimeOptions rt;
+  rt::RealtimeOptions rt;
   std::string junit;        // JUnit XML with the real-time figures as properties ("": none)
   const st::NativeCode* native = nullptr;
 };

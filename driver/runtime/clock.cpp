@@ -67,12 +67,13 @@ int64_t RealTimePacer::monotonic_ns() {
 
 void RealTimePacer::start() { next_ = monotonic_ns() + period_ns_; }
 
-void RealTimePacer::wait_next() {
+uint64_t RealTimePacer::wait_next() {
   int64_t now = monotonic_ns();
+  int64_t missed = 0;
   if (now > next_) {
     ++overruns_;
     // Skip the missed deadlines: the next one is the first in the future.
-    int64_t missed = (now - next_) / period_ns_ + 1;
+    missed = (now - next_) / period_ns_ + 1;
     next_ += missed * period_ns_;
   }
   timespec ts{static_cast<time_t>(next_ / 1'000'000'000), static_cast<long>(next_ % 1'000'000'000)};
@@ -80,6 +81,7 @@ void RealTimePacer::wait_next() {
   }
   latency_.add(monotonic_ns() - next_);
   next_ += period_ns_;
+  return static_cast<uint64_t>(missed);
 }
 
 }  // namespace plcfi::rt

@@ -37,8 +37,9 @@ class RealTimePacer {
   void start();
   // Sleeps until the next deadline (absolute). If the deadline has already passed the
   // cycle overran: it is counted and the next deadline is the first one in the future,
-  // so a late cycle is never followed by a burst of catch-up cycles.
-  void wait_next();
+  // so a late cycle is never followed by a burst of catch-up cycles. Returns how many
+  // deadlines were skipped (0 on time): cycles that real time went through unscanned.
+  uint64_t wait_next();
   // The caller reports how long the scan took after waking.
   void record_exec(int64_t ns) { exec_.add(ns); }
   static int64_t monotonic_ns();

@@ -90,6 +90,11 @@ const std::vector<uint64_t>& Runtime::probe_branches() {
   return probe_taken_;
 }
 
+void Runtime::skip_ticks(uint64_t n) {
+  scans_ += n;
+  now_ns_ += static_cast<int64_t>(n) * schedule_.tick_ns();
+}
+
 ScanStatus Runtime::scan() {
   const int64_t tick = schedule_.tick_ns();
   ScanStatus status = ScanStatus::Ok;

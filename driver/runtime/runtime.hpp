@@ -45,6 +45,10 @@ class Runtime {
   // One base tick. After a trap the program stays stopped (outputs in the safe state)
   // until a restart; later scans only exchange I/O.
   ScanStatus scan();
+  // Real time went through `n` base ticks without a scan (an overrun on the bench): the
+  // clock and the task counter move on, as a PLC's do when a cycle overran, so timers
+  // keep following the real clock and the plant.
+  void skip_ticks(uint64_t n);
 
   void add_hooks(ScanHooks* h) { hooks_.push_back(h); }
   void remove_hooks(ScanHooks* h);

@@ -20,6 +20,17 @@ sed "s/127.0.0.1:1502/127.0.0.1:$port/" "$src"/st_programs/stamping/io_plant_ser
 { cat "$work"/offline.yaml; echo "io: io.yaml"; } > "$work"/bench.yaml
 
 verdicts() { sed -n 's/^\(TC[0-9]*\) *\([0-9-]*\) *\(PASS\|FAIL\|NOT REACHED\) .*/\1 \2 \3/p' "$1" | sort; }
+# The bench gives the offline verdicts: every case tested, each (case, path) verdict one
+# the offline run gave. On a loaded machine a path that shows up late in a run (the second
+# path of TC1 and TC2, after six seconds) may fall outside the search window: a coverage
+# difference, reported as such, not a different verdict.
+same_verdicts() {  # offline.v bench.v
+  local wrong
+  wrong=$(comm -13 "$1" "$2")
+  [[ -z "$wrong" ]] || { echo "verdicts the offline run did not give: $wrong"; return 1; }
+  diff <(cut -d' ' -f1 "$1" | sort -u) <(cut -d' ' -f1 "$2" | sort -u) || { echo "cases not tested on the bench"; return 1; }
+  comm -23 "$1" "$2" | sed 's/^/not reached on the bench (load): /'
+}
 
 echo "== offline"
 "$plcfi" campaign "$work"/offline.yaml --out "$work"/offline --quiet --no-vcd > "$work"/offline.txt || test $? -eq 1
@@ -41,7 +52,7 @@ for _ in $(seq 1 200); do grep -q listening "$work"/server.log && break; sleep 0
 "$plcfi" campaign "$work"/bench.yaml --arm --out "$work"/bench --quiet --no-vcd > "$work"/bench.txt || test $? -eq 1
 cat "$work"/bench.txt
 verdicts "$work"/bench.txt | tee "$work"/bench.v
-diff "$work"/offline.v "$work"/bench.v
+same_verdicts "$work"/offline.v "$work"/bench.v
 grep -q "wake latency   min" "$work"/bench.txt
 
 echo "== SIGINT mid-campaign, then --resume"
@@ -62,7 +73,7 @@ test "$coils" = 1000000   # the io file's safe state: the slider valve on, all e
 "$plcfi" campaign "$work"/bench.yaml --arm --out "$work"/bench2 --resume --quiet --no-vcd > "$work"/bench3.txt || test $? -eq 1
 cat "$work"/bench3.txt
 verdicts "$work"/bench3.txt | tee "$work"/bench3.v
-diff "$work"/offline.v "$work"/bench3.v
+same_verdicts "$work"/offline.v "$work"/bench3.v
 
 kill -INT $server
 wait $server || true

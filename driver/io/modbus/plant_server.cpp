@@ -63,7 +63,7 @@ struct Ctx {
 
 }  // namespace
 
-bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::atomic<bool>& stop, PlantServerStats* stats,
+bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::function<bool()>& stop, PlantServerStats* stats,
                  std::string* err, void (*on_listening)(const PlantServerOptions&)) {
   const auto& sig = plant.signals();
   std::vector<Binding> bind;
@@ -118,7 +118,7 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
   // The plant's clock starts with the first client: a PLC that connects later does not
   // miss what the operator does at the start (the start button press, for instance).
   bool running = false;
-  while (!stop.load()) {
+  while (!stop()) {
     auto now = clock::now();
     if (opt.duration_ns > 0 && now - start >= std::chrono::nanoseconds(opt.duration_ns)) break;
     if (!running && !clients.empty()) {
@@ -126,10 +126,17 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
       next = now + std::chrono::nanoseconds(opt.tick_ns);
     }
     if (running && now >= next) {
-      // Step on absolute deadlines; a late step is counted, not made up for in a burst.
+      // Step on absolute deadlines. A late server (a loaded machine) counts the late step
+      // and makes the steps it missed at once: the plant's physics must keep real time,
+      // as the PLC's clock does, or the program's supervision times would run against a
+      // slowed-down plant. Beyond a second behind, the rest is dropped.
+      int steps = 1;
       if (now - next > std::chrono::nanoseconds(opt.tick_ns)) {
         ++stats->late_steps;
-        next = now;
+        auto behind = (now - next) / std::chrono::nanoseconds(opt.tick_ns);
+        const int64_t max_catch_up = std::max<int64_t>(1, 1'000'000'000 / opt.tick_ns);
+        steps = static_cast<int>(std::min<int64_t>(behind, max_catch_up)) + 1;
+        if (behind > max_catch_up) next = now - std::chrono::nanoseconds(opt.tick_ns) * max_catch_up;
       }
       if (c.map->tab_registers[kResetRegister] != 0) {
         // A test system asks for a new start: the plant back to its initial state.
@@ -142,10 +149,12 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
         if (b.input) continue;
         act[b.signal] = b.bit ? c.map->tab_bits[b.index] : static_cast<double>(static_cast<int16_t>(c.map->tab_registers[b.index]));
       }
-      plant.step(dt, act.data(), sen.data());
+      for (int k = 0; k < steps; ++k) {
+        plant.step(dt, act.data(), sen.data());
+        ++stats->steps;
+        next += std::chrono::nanoseconds(opt.tick_ns);
+      }
       publish();
-      ++stats->steps;
-      next += std::chrono::nanoseconds(opt.tick_ns);
       continue;
     }
     // Wait for requests until the next step is due.

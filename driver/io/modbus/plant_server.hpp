@@ -7,6 +7,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -33,7 +34,7 @@ struct PlantServerStats {
 // Serves until `stop` becomes true, the duration ends, or an error. Returns false with a
 // message (bad address, port in use) in *err. Single-threaded: requests are answered
 // between plant steps. `on_listening` is called once the socket listens.
-bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::atomic<bool>& stop, PlantServerStats* stats,
+bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::function<bool()>& stop, PlantServerStats* stats,
                  std::string* err, void (*on_listening)(const PlantServerOptions&) = nullptr);
 
 // Parses "%IX0.4" / "%QW2" into (input?, bit?, index): index = 8*byte+bit for bits, the word

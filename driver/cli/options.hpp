@@ -1,0 +1,83 @@
+// Whole-number command-line options with their range checked while the options are parsed:
+// Boost's own conversion reads "-1" for an unsigned option as 2^64-1, so `--cycles -1` ran
+// for ever. Use po::value<Count>() or po::value<IntIn<lo, hi>>() instead of the bare types.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <boost/any.hpp>
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+namespace plcfi::cli {
+
+// Decimal digits with an optional sign, no spaces: the sign and the magnitude. False when
+// the text is not such a number or the magnitude exceeds 2^64-1.
+inline bool parse_whole(const std::string& text, bool* negative, uint64_t* magnitude) {
+  size_t i = 0;
+  *negative = false;
+  if (i < text.size() && (text[i] == '-' || text[i] == '+')) *negative = text[i++] == '-';
+  if (i == text.size()) return false;
+  uint64_t v = 0;
+  for (; i < text.size(); ++i) {
+    char c = text[i];
+    if (c < '0' || c > '9') return false;
+    unsigned d = static_cast<unsigned>(c - '0');
+    if (v > (std::numeric_limits<uint64_t>::max() - d) / 10) return false;
+    v = v * 10 + d;
+  }
+  *magnitude = v;
+  return true;
+}
+
+// The error names the option (Boost fills it in) and the range expected.
+class OutOfRangeError : public boost::program_options::error_with_option_name {
+ public:
+  OutOfRangeError(const std::string& token, const std::string& expected)
+      : error_with_option_name("option '%canonical_option%': '%value%' is not " + expected, "", token) {
+    set_substitute("value", token);
+  }
+};
+
+// A count of cycles, iterations, ...: 0 up to 2^64-1.
+struct Count {
+  uint64_t value = 0;
+};
+
+inline void validate(boost::any& out, const std::vector<std::string>& values, Count*, int) {
+  boost::program_options::validators::check_first_occurrence(out);
+  const std::string& s = boost::program_options::validators::get_single_string(values);
+  bool neg = false;
+  uint64_t v = 0;
+  if (!parse_whole(s, &neg, &v) || (neg && v != 0))
+    throw OutOfRangeError(s, fmt::format("a whole number from 0 to {}", std::numeric_limits<uint64_t>::max()));
+  out = Count{v};
+}
+
+// A small signed setting with a fixed range (a priority, a CPU number).
+template <int64_t Lo, int64_t Hi>
+struct IntIn {
+  static_assert(Lo <= Hi);
+  int64_t value = Lo;
+};
+
+template <int64_t Lo, int64_t Hi>
+void validate(boost::any& out, const std::vector<std::string>& values, IntIn<Lo, Hi>*, int) {
+  boost::program_options::validators::check_first_occurrence(out);
+  const std::string& s = boost::program_options::validators::get_single_string(values);
+  bool neg = false;
+  uint64_t v = 0;
+  // Lo and Hi are small: a magnitude past 2^62 is out of range whatever its sign.
+  bool ok = parse_whole(s, &neg, &v) && v < (uint64_t{1} << 62);
+  int64_t x = ok ? (neg ? -static_cast<int64_t>(v) : static_cast<int64_t>(v)) : 0;
+  if (!ok || x < Lo || x > Hi) throw OutOfRangeError(s, fmt::format("a whole number from {} to {}", Lo, Hi));
+  out = IntIn<Lo, Hi>{x};
+}
+
+using RtPriority = IntIn<0, 99>;  // SCHED_FIFO priority; 0 keeps the normal scheduler
+using CpuIndex = IntIn<-1, 1023>;  // CPU affinity; -1 leaves the thread on any CPU
+
+}  // namespace plcfi::cli
