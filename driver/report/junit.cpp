@@ -8,19 +8,52 @@
 
 namespace plcfi::report {
 
+namespace {
+
+// Length of the well-formed UTF-8 sequence at s[i] (1..4), or 0 when it is not one
+// (stray continuation byte, overlong form, surrogate, past U+10FFFF, truncated).
+size_t utf8_length(const std::string& s, size_t i) {
+  auto b = [&](size_t k) { return static_cast<unsigned char>(s[k]); };
+  unsigned char c = b(i);
+  if (c < 0x80) return 1;
+  size_t n = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 0;
+  if (n == 0 || c > 0xF4 || i + n > s.size()) return 0;
+  for (size_t k = 1; k < n; ++k)
+    if ((b(i + k) & 0xC0) != 0x80) return 0;
+  if (n == 3 && ((c == 0xE0 && b(i + 1) < 0xA0) || (c == 0xED && b(i + 1) >= 0xA0))) return 0;  // overlong, surrogate
+  if (n == 4 && ((c == 0xF0 && b(i + 1) < 0x90) || (c == 0xF4 && b(i + 1) >= 0x90))) return 0;  // overlong, > U+10FFFF
+  return n;
+}
+
+}  // namespace
+
+// Messages come from anywhere (ST strings, device errors, file names): whatever the bytes,
+// the report stays well-formed XML 1.0 in UTF-8.
 std::string xml_escape(const std::string& s) {
   std::string out;
-  for (char c : s) {
+  out.reserve(s.size());
+  for (size_t i = 0; i < s.size();) {
+    char c = s[i];
     switch (c) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;
       case '>': out += "&gt;"; break;
       case '"': out += "&quot;"; break;
       case '\'': out += "&apos;"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') out += fmt::format("&#{};", static_cast<int>(c));
-        else out += c;
+      default: {
+        auto u = static_cast<unsigned char>(c);
+        if (u < 0x20 && c != '\n' && c != '\t' && c != '\r') {
+          out += fmt::format("\\x{:02x}", u);  // XML 1.0 cannot carry it, not even as &#N;
+        } else if (size_t n = utf8_length(s, i); n == 0) {
+          out += "\xEF\xBF\xBD";  // U+FFFD for a byte that is not UTF-8
+        } else {
+          out.append(s, i, n);
+          i += n;
+          continue;
+        }
+      }
     }
+    ++i;
   }
   return out;
 }

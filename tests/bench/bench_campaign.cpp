@@ -14,6 +14,7 @@
 #include "campaign/driver.hpp"
 #include "campaign/generate.hpp"
 #include "runtime/runtime.hpp"
+#include "../support/fake_backend.hpp"
 
 namespace {
 
@@ -49,25 +50,13 @@ BENCHMARK(BM_campaign_stamping)->Unit(benchmark::kMillisecond);
 
 // A synthetic plant: a counter on %IW0 that never reaches the preconditions' values, so
 // every case stays pending and the driver evaluates all preconditions every scan.
-class CounterBackend final : public rt::IoBackend {
- public:
-  const std::string& name() const override { return name_; }
-  uint32_t input_extent() const override { return 4; }
-  uint32_t output_extent() const override { return 0; }
-  bool read(uint8_t* in, int64_t) override {
-    uint16_t v = static_cast<uint16_t>(n_++ % 30000);
-    in[0] = static_cast<uint8_t>(v);
-    in[1] = static_cast<uint8_t>(v >> 8);
-    return true;
-  }
-  bool write(const uint8_t*, int64_t, int64_t) override { return true; }
-  void reset(uint64_t) override { n_ = 0; }
-  const std::string& last_error() const override { return name_; }
-
- private:
-  std::string name_ = "counter";
-  uint64_t n_ = 0;
-};
+testing_support::FakeBackend counter_backend() {
+  testing_support::FakeBackend b(4, 0, "counter");
+  b.on_read = [n = uint64_t{0}](uint8_t* in, int64_t) mutable {
+    testing_support::FakeBackend::put_u16(in, static_cast<uint16_t>(n++ % 30000));
+  };
+  return b;
+}
 
 // Writes a campaign with n cases (one TSD step and one FMEA row each) into a folder.
 std::string synthetic_campaign(size_t n) {
@@ -107,7 +96,7 @@ void BM_campaign_driver_per_scan(benchmark::State& state) {
     return;
   }
   fs::remove_all(fs::path(path).parent_path());
-  CounterBackend backend;
+  auto backend = counter_backend();
   double with_driver = 0, baseline = 0;
   for (auto _ : state) {
     // The same scans of the same program without the driver (baseline)...

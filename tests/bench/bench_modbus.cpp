@@ -16,79 +16,20 @@
 #include "engine.hpp"
 #include "io/io_config.hpp"
 #include "io/modbus/modbus_backend.hpp"
+#include "../support/modbus_slave.hpp"
 
 namespace {
 
 using namespace plcfi;
 
-class Server {
- public:
-  Server() {
-    ctx_ = modbus_new_tcp("127.0.0.1", 0);
-    listen_ = modbus_tcp_listen(ctx_, 4);
-    sockaddr_in a{};
-    socklen_t len = sizeof a;
-    getsockname(listen_, reinterpret_cast<sockaddr*>(&a), &len);
-    port = ntohs(a.sin_port);
-    map_ = modbus_mapping_new(64, 64, 64, 64);
-    thread_ = std::thread([this] { loop(); });
-  }
-  ~Server() {
-    stop_ = true;
-    thread_.join();
-    ::close(listen_);
-    modbus_mapping_free(map_);
-    modbus_free(ctx_);
-  }
-  int port = 0;
-
- private:
-  void loop() {
-    std::vector<int> clients;
-    uint8_t q[MODBUS_TCP_MAX_ADU_LENGTH];
-    while (!stop_) {
-      fd_set rd;
-      FD_ZERO(&rd);
-      FD_SET(listen_, &rd);
-      int mx = listen_;
-      for (int c : clients) FD_SET(c, &rd), mx = std::max(mx, c);
-      timeval tv{0, 20'000};
-      if (select(mx + 1, &rd, nullptr, nullptr, &tv) <= 0) continue;
-      if (FD_ISSET(listen_, &rd)) {
-        int c = modbus_tcp_accept(ctx_, &listen_);
-        if (c >= 0) clients.push_back(c);
-      }
-      for (size_t i = 0; i < clients.size();) {
-        if (!FD_ISSET(clients[i], &rd)) {
-          ++i;
-          continue;
-        }
-        modbus_set_socket(ctx_, clients[i]);
-        int n = modbus_receive(ctx_, q);
-        if (n > 0) modbus_reply(ctx_, q, n, map_);
-        if (n < 0) {
-          ::close(clients[i]);
-          clients.erase(clients.begin() + static_cast<long>(i));
-        } else {
-          ++i;
-        }
-      }
-    }
-    for (int c : clients) ::close(c);
-  }
-  modbus_t* ctx_;
-  modbus_mapping_t* map_;
-  int listen_;
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
-};
+using Server = testing_support::ModbusSlave;
 
 // The stamping module's map: 11 discrete inputs, 1 input register, 6 coils, 1 holding register.
 const char* kProgram = "PROGRAM P\nVAR x AT %IX0.0 : BOOL; p AT %IW2 : INT; y AT %QX0.0 : BOOL; sp AT %QW2 : INT; END_VAR\nEND_PROGRAM\n";
 
 void BM_modbus_cycle_raw_libmodbus(benchmark::State& state) {
   Server server;
-  modbus_t* ctx = modbus_new_tcp("127.0.0.1", server.port);
+  modbus_t* ctx = modbus_new_tcp("127.0.0.1", server.port());
   modbus_set_slave(ctx, 1);
   modbus_set_response_timeout(ctx, 0, 5000);
   if (modbus_connect(ctx) != 0) {
@@ -112,7 +53,7 @@ void BM_modbus_cycle_backend(benchmark::State& state) {
   Server server;
   auto b = st::build_sources({{"p.st", kProgram}}, st::CompileOptions{});
   auto path = (std::filesystem::temp_directory_path() / ("plcfi_bench_io_" + std::to_string(::getpid()) + ".yaml")).string();
-  std::ofstream(path) << "io:\n  devices:\n    - {name: d, tcp: \"127.0.0.1:" << server.port << "\", timeout: 5ms}\n  map:\n"
+  std::ofstream(path) << "io:\n  devices:\n    - {name: d, tcp: \"127.0.0.1:" << server.port() << "\", timeout: 5ms}\n  map:\n"
                       << "    - {image: \"%IX0.0\", count: 11, device: d, discrete_inputs: 0}\n"
                       << "    - {image: \"%IW2\", count: 1, device: d, input_registers: 2}\n"
                       << "    - {image: \"%QX0.0\", count: 6, device: d, coils: 0}\n"

@@ -3,6 +3,7 @@
 // against an independent implementation (pymodbus) over TCP and over RTU on a pty pair.
 #include <gtest/gtest.h>
 
+#include "../support/modbus_slave.hpp"
 #include "../support/temp_files.hpp"
 
 #include <atomic>
@@ -165,89 +166,15 @@ TEST_F(ModbusIo, Ipv6AndHostNamesParse) {
 
 // ------------------------------------------------------------------ in-process libmodbus server
 
-// A libmodbus TCP server on a thread; stop() closes every socket (a crashed device).
-class LibmodbusServer {
+// The shared in-process slave, with the values these tests read back.
+class LibmodbusServer : public testing_support::ModbusSlave {
  public:
-  explicit LibmodbusServer(int port, std::string host = "127.0.0.1") : port_(port), host_(std::move(host)) {
-    map_ = modbus_mapping_new(32, 32, 32, 32);
-    map_->tab_input_bits[0] = 1;
-    map_->tab_input_bits[2] = 1;
-    map_->tab_input_registers[0] = 41;
-    map_->tab_input_registers[3] = static_cast<uint16_t>(-7);
-    start();
+  explicit LibmodbusServer(int port, std::string host = "127.0.0.1") : ModbusSlave(port, std::move(host), 32) {
+    map()->tab_input_bits[0] = 1;
+    map()->tab_input_bits[2] = 1;
+    map()->tab_input_registers[0] = 41;
+    map()->tab_input_registers[3] = static_cast<uint16_t>(-7);
   }
-  ~LibmodbusServer() {
-    stop();
-    modbus_mapping_free(map_);
-  }
-  void start() {
-    stop_ = false;
-    // libmodbus sets SO_REUSEADDR: a restart rebinds at once.
-    if (host_.find(':') != std::string::npos) {  // IPv6: the protocol-independent calls
-      ctx_ = modbus_new_tcp_pi(host_.c_str(), std::to_string(port_).c_str());
-      listen_ = modbus_tcp_pi_listen(ctx_, 4);
-    } else {
-      ctx_ = modbus_new_tcp(host_.c_str(), port_);
-      listen_ = modbus_tcp_listen(ctx_, 4);
-    }
-    thread_ = std::thread([this] { loop(); });
-  }
-  void stop() {
-    if (!ctx_) return;
-    stop_ = true;
-    thread_.join();
-    if (listen_ >= 0) ::close(listen_);
-    modbus_free(ctx_);
-    ctx_ = nullptr;
-  }
-  modbus_mapping_t* map() { return map_; }
-  std::atomic<int> requests{0};
-
- private:
-  void loop() {
-    std::vector<int> clients;
-    uint8_t q[MODBUS_TCP_MAX_ADU_LENGTH];
-    while (!stop_) {
-      fd_set rd;
-      FD_ZERO(&rd);
-      FD_SET(listen_, &rd);
-      int mx = listen_;
-      for (int c : clients) FD_SET(c, &rd), mx = std::max(mx, c);
-      timeval tv{0, 20'000};
-      if (select(mx + 1, &rd, nullptr, nullptr, &tv) <= 0) continue;
-      if (FD_ISSET(listen_, &rd)) {
-        int c = host_.find(':') != std::string::npos ? modbus_tcp_pi_accept(ctx_, &listen_) : modbus_tcp_accept(ctx_, &listen_);
-        if (c >= 0) clients.push_back(c);
-      }
-      for (size_t i = 0; i < clients.size();) {
-        if (!FD_ISSET(clients[i], &rd)) {
-          ++i;
-          continue;
-        }
-        modbus_set_socket(ctx_, clients[i]);
-        int n = modbus_receive(ctx_, q);
-        if (n > 0) {
-          ++requests;  // counted before the reply goes out: the client sees it once answered
-          modbus_reply(ctx_, q, n, map_);
-          ++i;
-        } else if (n < 0) {
-          ::close(clients[i]);
-          clients.erase(clients.begin() + static_cast<long>(i));
-        } else {
-          ++i;
-        }
-      }
-    }
-    for (int c : clients) ::close(c);
-    modbus_set_socket(ctx_, -1);
-  }
-  int port_;
-  std::string host_;
-  modbus_t* ctx_ = nullptr;
-  modbus_mapping_t* map_ = nullptr;
-  int listen_ = -1;
-  std::thread thread_;
-  std::atomic<bool> stop_{false};
 };
 
 TEST_F(ModbusIo, TimeoutMustBeBelowTheCycle) {

@@ -12,35 +12,26 @@
 #include "engine.hpp"
 #include "faults/fault_model.hpp"
 #include "runtime/runtime.hpp"
+#include "../../support/fake_backend.hpp"
 
 namespace plcfi::faults {
 namespace {
 
-// Scripted plant side: delivers `bit` on %IX0.0 and `word` on %IW2, records %QX0.0 / %QW2.
-class ScriptBackend final : public rt::IoBackend {
- public:
-  const std::string& name() const override { return name_; }
-  uint32_t input_extent() const override { return 6; }
-  uint32_t output_extent() const override { return 6; }
-  bool read(uint8_t* in, int64_t) override {
-    in[0] = bit ? 1 : 0;
-    in[4] = static_cast<uint8_t>(word & 0xff);
-    in[5] = static_cast<uint8_t>((word >> 8) & 0xff);
-    return true;
+// Scripted plant side on the shared fake: delivers `bit` on %IX0.0 and `word` on %IW2,
+// reads back %QX0.0 / %QW2.
+struct ScriptPlant {
+  ScriptPlant() : io(6, 6, "script") {
+    io.on_read = [this](uint8_t* in, int64_t) {
+      in[0] = bit ? 1 : 0;
+      testing_support::FakeBackend::put_u16(in + 4, static_cast<uint16_t>(word));
+    };
   }
-  bool write(const uint8_t* out, int64_t, int64_t) override {
-    out_bit = out[0] & 1;
-    out_word = static_cast<int16_t>(out[4] | (out[5] << 8));
-    return true;
-  }
-  void reset(uint64_t) override {}
-  const std::string& last_error() const override { return name_; }
+  bool out_bit() const { return io.outputs[0] & 1; }
+  int16_t out_word() const { return io.output_i16(4); }
 
-  std::string name_ = "script";
+  testing_support::FakeBackend io;
   bool bit = false;
   int16_t word = 0;
-  bool out_bit = false;
-  int16_t out_word = 0;
 };
 
 // The program copies its inputs and drives outputs from commands the test sets.
@@ -70,7 +61,7 @@ class FaultFixture : public ::testing::Test {
     ASSERT_TRUE(b_->ok()) << b_->diags.render_all();
     std::string err;
     ASSERT_TRUE(sched_.single_program(*b_->app, "P", 10'000'000, &err)) << err;
-    rt_ = std::make_unique<rt::Runtime>(*b_->app, sched_, &plant_);
+    rt_ = std::make_unique<rt::Runtime>(*b_->app, sched_, &plant_.io);
     rt_->cold_restart(1);
     for (const char* v : {"P.seenX", "P.seenP", "P.cmdY", "P.cmdSp", "P.y", "P.sp"}) h_[v] = *st::resolve(*b_->app, v, &err);
   }
@@ -109,7 +100,7 @@ class FaultFixture : public ::testing::Test {
 
   std::unique_ptr<st::Build> b_;
   rt::Schedule sched_;
-  ScriptBackend plant_;
+  ScriptPlant plant_;
   std::unique_ptr<rt::Runtime> rt_;
   std::map<std::string, st::VarHandle> h_;
 };
@@ -332,23 +323,23 @@ TEST_F(FaultFixture, NoEffectKeepsThePlantOnThePreFaultCommand) {
   set("P.cmdY", 1);
   rt_->scan();
   EXPECT_EQ(get("P.y"), 1);       // the program commands...
-  EXPECT_FALSE(plant_.out_bit);   // ...the plant never gets it
+  EXPECT_FALSE(plant_.out_bit());   // ...the plant never gets it
   rt_->output_overlay().clear();
   rt_->scan();
-  EXPECT_TRUE(plant_.out_bit);
+  EXPECT_TRUE(plant_.out_bit());
 }
 
 TEST_F(FaultFixture, StuckOnAndStuckOff) {
   inject("stuck_on", "%QX0.0");
   set("P.cmdY", 0);
   rt_->scan();
-  EXPECT_TRUE(plant_.out_bit);
+  EXPECT_TRUE(plant_.out_bit());
   EXPECT_EQ(get("P.y"), 0);
   rt_->output_overlay().clear();
   inject("stuck_off", "%QW2");
   set("P.cmdSp", 6000);
   rt_->scan();
-  EXPECT_EQ(plant_.out_word, 0);
+  EXPECT_EQ(plant_.out_word(), 0);
   EXPECT_EQ(get("P.sp"), 6000);
 }
 
@@ -359,7 +350,7 @@ TEST_F(FaultFixture, DelayedCommandsReachThePlantLate) {
   for (int v : {100, 200, 300, 400}) {
     set("P.cmdSp", v);
     rt_->scan();
-    got.push_back(plant_.out_word);
+    got.push_back(plant_.out_word());
   }
   EXPECT_EQ(got, (std::vector<int>{0, 0, 100, 200}));
 }
@@ -379,23 +370,6 @@ TEST_F(FaultFixture, RulesDescribeThemselves) {
 namespace plcfi::faults {
 namespace {
 
-// Delivers a REAL at %ID1 (bytes 4..7).
-class RealBackend final : public rt::IoBackend {
- public:
-  const std::string& name() const override { return name_; }
-  uint32_t input_extent() const override { return 8; }
-  uint32_t output_extent() const override { return 0; }
-  bool read(uint8_t* in, int64_t) override {
-    std::memcpy(in + 4, &level, 4);
-    return true;
-  }
-  bool write(const uint8_t*, int64_t, int64_t) override { return true; }
-  void reset(uint64_t) override {}
-  const std::string& last_error() const override { return name_; }
-  std::string name_ = "real";
-  float level = 0;
-};
-
 // A REAL sensor is faulted by value (offset, gain, frozen, drift, open wire), not by its bits.
 TEST(FaultReal, AnalogRealSensorsAreFaultedByValue) {
   auto b = st::build_sources({{"r.st", "PROGRAM P\nVAR\n  level AT %ID1 : REAL;\n  seen : REAL;\nEND_VAR\nseen := level;\nEND_PROGRAM\n"}},
@@ -404,7 +378,9 @@ TEST(FaultReal, AnalogRealSensorsAreFaultedByValue) {
   rt::Schedule sched;
   std::string err;
   ASSERT_TRUE(sched.single_program(*b->app, "P", 10'000'000, &err)) << err;
-  RealBackend plant;
+  float level = 0;
+  testing_support::FakeBackend plant(8, 0, "real");  // a REAL at %ID1 (bytes 4..7)
+  plant.on_read = [&level](uint8_t* in, int64_t) { std::memcpy(in + 4, &level, 4); };
   rt::Runtime r(*b->app, sched, &plant);
   r.cold_restart(1);
   auto seen = *st::resolve(*b->app, "P.seen", &err);
@@ -426,7 +402,7 @@ TEST(FaultReal, AnalogRealSensorsAreFaultedByValue) {
     r.input_overlay().add(std::move(rule));
   };
   auto scan = [&](float v) {
-    plant.level = v;
+    level = v;
     r.scan();
     return st::read_real(r.machine(), seen);
   };

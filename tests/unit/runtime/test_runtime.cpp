@@ -5,47 +5,30 @@
 #include "engine.hpp"
 #include "runtime/clock.hpp"
 #include "runtime/runtime.hpp"
+#include "../../support/fake_backend.hpp"
 
 namespace plcfi::rt {
 namespace {
 
-// A backend that records calls and echoes a scripted input byte.
-class FakeBackend final : public IoBackend {
+// The shared fake, delivering a scripted byte at %IB0 and logging the scan order.
+class FakeBackend {
  public:
-  const std::string& name() const override { return name_; }
-  uint32_t input_extent() const override { return 4; }
-  uint32_t output_extent() const override { return 4; }
-  bool read(uint8_t* inputs, int64_t now_ns) override {
-    log += "read@" + std::to_string(now_ns / 1'000'000) + " ";
-    inputs[0] = input_byte;
-    return true;
+  FakeBackend() : io(4, 4) {
+    io.record_log = true;
+    io.on_read = [this](uint8_t* in, int64_t) { in[0] = input_byte; };
   }
-  bool write(const uint8_t* outputs, int64_t, int64_t dt_ns) override {
-    log += "write ";
-    last_out = outputs[0];
-    last_dt = dt_ns;
-    ++writes;
-    return true;
-  }
-  void reset(uint64_t seed) override {
-    resets++;
-    last_seed = seed;
-  }
-  const std::string& last_error() const override { return name_; }
+  uint8_t last_out() const { return io.outputs[0]; }
 
-  std::string name_ = "fake", log;
-  uint8_t input_byte = 0, last_out = 0;
-  int64_t last_dt = 0;
-  int resets = 0, writes = 0;
-  uint64_t last_seed = 0;
+  testing_support::FakeBackend io;
+  uint8_t input_byte = 0;
 };
 
 class OrderHooks final : public ScanHooks {
  public:
   explicit OrderHooks(FakeBackend* b) : b_(b) {}
-  void before_scan(Runtime&) override { b_->log += "before "; }
-  void after_scan(Runtime&) override { b_->log += "after "; }
-  void end_of_scan(Runtime&) override { b_->log += "end "; }
+  void before_scan(Runtime&) override { b_->io.log += "before "; }
+  void after_scan(Runtime&) override { b_->io.log += "after "; }
+  void end_of_scan(Runtime&) override { b_->io.log += "end "; }
 
  private:
   FakeBackend* b_;
@@ -78,17 +61,17 @@ TEST(Runtime, ScanOrderIsReadOverlayHooksTasksWrite) {
   std::string err;
   ASSERT_TRUE(s.single_program(*b->app, "Echo", 10'000'000, &err)) << err;
   FakeBackend fb;
-  Runtime r(*b->app, s, &fb);
+  Runtime r(*b->app, s, &fb.io);
   OrderHooks hooks(&fb);
   r.add_hooks(&hooks);
   r.cold_restart(7);
-  EXPECT_EQ(1, fb.resets);
-  EXPECT_EQ(7u, fb.last_seed);
-  fb.log.clear();
+  EXPECT_EQ(1, fb.io.resets);
+  EXPECT_EQ(7u, fb.io.last_seed);
+  fb.io.log.clear();
   r.scan();
   r.scan();
-  EXPECT_EQ("read@0 before after write end read@10 before after write end ", fb.log);
-  EXPECT_EQ(10'000'000, fb.last_dt);
+  EXPECT_EQ("read@0 before after write end read@10 before after write end ", fb.io.log);
+  EXPECT_EQ(10'000'000, fb.io.last_dt);
   EXPECT_EQ(20'000'000, r.now());
 }
 
@@ -98,13 +81,13 @@ TEST(Runtime, WithoutOverlayBothLayersAreEqual) {
   std::string err;
   ASSERT_TRUE(s.single_program(*b->app, "", 10'000'000, &err));
   FakeBackend fb;
-  Runtime r(*b->app, s, &fb);
+  Runtime r(*b->app, s, &fb.io);
   r.cold_restart(1);
   fb.input_byte = 0b11;
   r.scan();
   EXPECT_EQ(0b11, r.raw_inputs()[0]);
   EXPECT_EQ(0b11, r.machine().mem()[b->app->image_i.addr]);
-  EXPECT_EQ(0b11, fb.last_out);
+  EXPECT_EQ(0b11, fb.last_out());
   EXPECT_EQ(0b11, r.delivered_outputs()[0]);
 }
 
@@ -114,7 +97,7 @@ TEST(Runtime, InputOverlayChangesWhatTheProgramSeesNotTheRawLayer) {
   std::string err;
   ASSERT_TRUE(s.single_program(*b->app, "", 10'000'000, &err));
   FakeBackend fb;
-  Runtime r(*b->app, s, &fb);
+  Runtime r(*b->app, s, &fb.io);
   r.cold_restart(1);
   ImageRef ref;
   ASSERT_TRUE(parse_image_ref(*b->app, "%IX0.1", &ref, &err)) << err;
@@ -123,10 +106,10 @@ TEST(Runtime, InputOverlayChangesWhatTheProgramSeesNotTheRawLayer) {
   r.scan();
   EXPECT_EQ(0b11, r.raw_inputs()[0]);                               // as delivered
   EXPECT_EQ(0b01, r.machine().mem()[b->app->image_i.addr]);         // as seen
-  EXPECT_EQ(0b01, fb.last_out);                                     // the program echoed what it saw
+  EXPECT_EQ(0b01, fb.last_out());                                     // the program echoed what it saw
   r.input_overlay().clear();
   r.scan();
-  EXPECT_EQ(0b11, fb.last_out);
+  EXPECT_EQ(0b11, fb.last_out());
 }
 
 TEST(Runtime, OutputOverlayChangesWhatThePlantReceivesNotTheProgramVariable) {
@@ -135,7 +118,7 @@ TEST(Runtime, OutputOverlayChangesWhatThePlantReceivesNotTheProgramVariable) {
   std::string err;
   ASSERT_TRUE(s.single_program(*b->app, "", 10'000'000, &err));
   FakeBackend fb;
-  Runtime r(*b->app, s, &fb);
+  Runtime r(*b->app, s, &fb.io);
   r.cold_restart(1);
   ImageRef ref;
   ASSERT_TRUE(parse_image_ref(*b->app, "%QX0.0", &ref, &err)) << err;
@@ -145,7 +128,7 @@ TEST(Runtime, OutputOverlayChangesWhatThePlantReceivesNotTheProgramVariable) {
   auto out0 = st::resolve(*b->app, "Echo.out0", &err);
   ASSERT_TRUE(out0) << err;
   EXPECT_TRUE(st::read_bool(r.machine(), *out0));  // the program wrote TRUE
-  EXPECT_EQ(0, fb.last_out & 1);                    // the plant got FALSE
+  EXPECT_EQ(0, fb.last_out() & 1);                    // the plant got FALSE
 }
 
 TEST(Runtime, ImageRefByAddressTakesTheDeclaredVariablesType) {
@@ -204,22 +187,22 @@ END_PROGRAM
   std::string err;
   ASSERT_TRUE(s.single_program(*b->app, "", 10'000'000, &err));
   FakeBackend fb;
-  Runtime r(*b->app, s, &fb);
+  Runtime r(*b->app, s, &fb.io);
   r.cold_restart(1);
   EXPECT_EQ(ScanStatus::Ok, r.scan());
-  EXPECT_EQ(1, fb.last_out & 1);
+  EXPECT_EQ(1, fb.last_out() & 1);
   EXPECT_EQ(ScanStatus::Ok, r.scan());
   EXPECT_EQ(ScanStatus::Trapped, r.scan());
   EXPECT_TRUE(r.stopped());
-  EXPECT_EQ(0, fb.last_out & 1) << "outputs must be off after the trap";
+  EXPECT_EQ(0, fb.last_out() & 1) << "outputs must be off after the trap";
   EXPECT_NE(std::string::npos, r.stop_reason().find("rt.st:11:")) << r.stop_reason();
   EXPECT_NE(std::string::npos, r.stop_reason().find("division by zero")) << r.stop_reason();
   EXPECT_EQ(ScanStatus::Stopped, r.scan());
-  EXPECT_EQ(0, fb.last_out & 1);
+  EXPECT_EQ(0, fb.last_out() & 1);
   // A restart brings the program back.
   r.cold_restart(1);
   EXPECT_EQ(ScanStatus::Ok, r.scan());
-  EXPECT_EQ(1, fb.last_out & 1);
+  EXPECT_EQ(1, fb.last_out() & 1);
 }
 
 TEST(Runtime, AnActuatorFaultDoesNotOverrideTheSafeStateAfterATrap) {
@@ -240,17 +223,17 @@ END_PROGRAM
   std::string err;
   ASSERT_TRUE(s.single_program(*b->app, "", 10'000'000, &err));
   FakeBackend fb;
-  Runtime r(*b->app, s, &fb);
+  Runtime r(*b->app, s, &fb.io);
   r.cold_restart(1);
   ImageRef ref;
   ASSERT_TRUE(parse_image_ref(*b->app, "%QX0.0", &ref, &err)) << err;
   r.output_overlay().add(std::make_unique<ForceRule>(ref, 1));  // the valve stuck on
   EXPECT_EQ(ScanStatus::Ok, r.scan());
-  EXPECT_EQ(1, fb.last_out & 1);  // the fault acts while the program runs
+  EXPECT_EQ(1, fb.last_out() & 1);  // the fault acts while the program runs
   EXPECT_EQ(ScanStatus::Trapped, r.scan());
-  EXPECT_EQ(0, fb.last_out & 1) << "the safe state, not the injected fault, after a trap";
+  EXPECT_EQ(0, fb.last_out() & 1) << "the safe state, not the injected fault, after a trap";
   EXPECT_EQ(ScanStatus::Stopped, r.scan());
-  EXPECT_EQ(0, fb.last_out & 1);
+  EXPECT_EQ(0, fb.last_out() & 1);
 }
 
 TEST(Runtime, TasksWithSeveralIntervalsRunAtTheirTicksInPriorityOrder) {
