@@ -2,6 +2,7 @@
 // (parse, check, compile, run with a small budget) without crashing or hanging.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -68,6 +69,10 @@ TEST(PipelineFuzz, MutatedSourcesNeverCrash) {
     if (!b->ok()) {
       ++rejected;
       EXPECT_TRUE(b->diags.has_errors()) << name << ": rejected without a diagnostic";
+      // Every diagnostic points into the text it was given (a line that exists).
+      const size_t lines = static_cast<size_t>(std::count(mutated.begin(), mutated.end(), '\n')) + 1;
+      for (const auto& d : b->diags.all())
+        EXPECT_LE(d.loc.line, lines) << name << ": " << d.code << " at line " << d.loc.line << " of " << lines;
       continue;
     }
     ++compiled;
@@ -76,8 +81,10 @@ TEST(PipelineFuzz, MutatedSourcesNeverCrash) {
     ro.budget = 20000;
     run_tests(*b->app, m, ro);  // traps are fine; crashes and hangs are not
   }
+  // Both outcomes occur: mutations that break nothing (in comments, swapped independent
+  // lines) and ones that break the program; all-rejected would mean a broken corpus.
   EXPECT_GT(rejected, 0u);
-  EXPECT_GT(compiled + rejected, 0u);
+  EXPECT_GT(compiled, 0u);
 }
 
 }  // namespace

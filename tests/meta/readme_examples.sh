@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Every command README.md shows (`$ ...` lines in its code blocks) runs as shown in a fresh
+# copy of the repository: the files it names exist and it ends with status 0 or 1 (a
+# check or a test that fails on purpose), never 2 (bad usage or input) unless README says
+# so after the command (`# exits 2`), and never with a crash.
+# usage: readme_examples.sh PLCFI SOURCE_DIR
+set -uo pipefail
+plcfi=$1
+src=$2
+work=$(mktemp -d "${TMPDIR:-/tmp}/plcfi_readme_XXXXXX")
+trap 'kill $(jobs -p) 2>/dev/null; rm -rf "$work"' EXIT
+(cd "$src" && git ls-files -z 2>/dev/null | xargs -0 cp --parents -t "$work" 2>/dev/null) || cp -r "$src"/. "$work"
+[[ -f "$work/README.md" ]] || { echo "cannot copy the repository"; exit 1; }
+mkdir -p "$work/.bin"
+ln -s "$plcfi" "$work/.bin/plcfi"
+export PATH="$work/.bin:$PATH"
+
+# The commands, continuation lines joined, in README order.
+mapfile -t commands < <(awk '
+  /^```/ { inblock = !inblock; next }
+  inblock && /^\$ / { cmd = substr($0, 3); while (cmd ~ /\\$/ && (getline line) > 0) cmd = substr(cmd, 1, length(cmd) - 1) " " line; print cmd }
+' "$work/README.md")
+(( ${#commands[@]} >= 10 )) || { echo "found only ${#commands[@]} commands in README.md"; exit 1; }
+
+cd "$work"
+failures=0
+for cmd in "${commands[@]}"; do
+  echo "\$ $cmd"
+  if [[ "$cmd" == *"&" ]]; then            # a server for the next commands
+    eval "${cmd% &*} > .bg.log 2>&1 &"
+    for _ in $(seq 1 100); do grep -q listening .bg.log 2>/dev/null && break; sleep 0.05; done
+    continue
+  fi
+  if [[ "$cmd" == kill* ]]; then           # ends that server: the job lives in this shell
+    eval "$cmd" || { echo "  -> FAILED"; failures=$((failures + 1)); }
+    wait
+    continue
+  fi
+  # A command shown failing on purpose says so: `$ plcfi ... # exits 2`.
+  expected="0 1"
+  [[ "$cmd" =~ \#\ *exits\ ([0-9]+) ]] && expected=${BASH_REMATCH[1]}
+  out=$(eval "$cmd" 2>&1)
+  status=$?
+  printf '%s\n' "$out" | tail -n 4
+  if [[ " $expected " != *" $status "* ]] || grep -qE "terminate called|Sanitizer|runtime error:" <<<"$out"; then
+    echo "  -> FAILED: exit status $status (expected ${expected// / or })"
+    failures=$((failures + 1))
+  fi
+done
+echo "${#commands[@]} README command(s), $failures failed"
+(( failures == 0 ))
