@@ -136,7 +136,8 @@ std::string YamlDoc::scalar(const YAML::Node& n, std::string_view what) const {
 }
 
 int64_t YamlDoc::integer(const YAML::Node& n, std::string_view what, int64_t lo, int64_t hi) const {
-  const std::string s = scalar(n, what);
+  if (!n.IsScalar()) fail(n, std::string(what) + ": expected an integer, got " + describe(n));
+  const std::string s = n.Scalar();
   std::string_view digits = s;
   bool negative = false;
   if (!digits.empty() && (digits[0] == '-' || digits[0] == '+')) {
@@ -162,7 +163,8 @@ int64_t YamlDoc::integer(const YAML::Node& n, std::string_view what, int64_t lo,
 }
 
 double YamlDoc::number(const YAML::Node& n, std::string_view what) const {
-  const std::string s = scalar(n, what);
+  if (!n.IsScalar()) fail(n, std::string(what) + ": expected a number, got " + describe(n));
+  const std::string s = n.Scalar();
   std::string_view text = s;
   if (!text.empty() && text[0] == '+') text.remove_prefix(1);
   double v = 0;
@@ -182,7 +184,8 @@ bool YamlDoc::boolean(const YAML::Node& n, std::string_view what) const {
 }
 
 int64_t YamlDoc::duration(const YAML::Node& n, std::string_view what, int64_t min_ns) const {
-  const std::string s = scalar(n, what);
+  if (!n.IsScalar()) fail(n, std::string(what) + ": expected a duration, got " + describe(n));
+  const std::string s = n.Scalar();
   const DurationParse r = parse_duration(s);
   if (!r.ok()) fail_in(n, r.error_at, std::string(what) + ": expected a duration, got '" + s + "': " + r.error);
   if (r.ns < min_ns) {

@@ -588,9 +588,8 @@ TEST_F(PlantStampingYaml, DefaultsWithoutFile) {
 
 TEST_F(PlantStampingYaml, DocumentedFileIsTheDefaults) {
   // The shipped stamping.yaml (all keys commented out) loads and changes nothing.
-  // CMake compiles with absolute source paths: tests/unit/ -> repository root.
-  const std::string shipped =
-      (std::filesystem::path(__FILE__).parent_path().parent_path().parent_path() / "plant_model/stamping/stamping.yaml").string();
+  // From the repository root CMake passes in (__FILE__ is relative under ccache's base_dir).
+  const std::string shipped = (std::filesystem::path(PLCFI_SOURCE_DIR) / "plant_model/stamping/stamping.yaml").string();
   StampingParams p;
   std::string err;
   ASSERT_TRUE(load_stamping_params(shipped, &p, &err)) << err;
