@@ -36,7 +36,7 @@ std::string size_text(size_t bytes) {
   return std::to_string(bytes) + " bytes";
 }
 
-bool read_file(const std::string& path, size_t max_bytes, std::string* text, std::string* err) {
+bool read_file(const std::string& path, size_t max_bytes, std::string* text, std::string* err, int stall_timeout_ms) {
   text->clear();
   // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer forever.
   Fd fd(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
@@ -68,10 +68,12 @@ bool read_file(const std::string& path, size_t max_bytes, std::string* text, std
   for (;;) {
     if (!regular) {
       pollfd p{fd.get(), POLLIN, 0};
-      const int r = ::poll(&p, 1, kStallTimeoutMs);
+      const int r = ::poll(&p, 1, stall_timeout_ms);
       if (r < 0 && errno == EINTR) continue;
       if (r == 0) {
-        *err = path + ": no data for " + std::to_string(kStallTimeoutMs / 1000) + " s (a pipe nobody writes to?)";
+        const std::string wait = stall_timeout_ms % 1000 == 0 ? std::to_string(stall_timeout_ms / 1000) + " s"
+                                                               : std::to_string(stall_timeout_ms) + " ms";
+        *err = path + ": no data for " + wait + " (a pipe nobody writes to?)";
         return false;
       }
     }

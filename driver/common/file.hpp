@@ -21,8 +21,10 @@ inline constexpr int kStallTimeoutMs = 10'000;
 //   "PATH: cannot open (REASON)", "PATH: is a directory",
 //   "PATH: is larger than N MiB" (stops reading at the limit, so endless inputs end),
 //   "PATH: read error (REASON)", "PATH: no data for 10 s (a pipe nobody writes to?)".
-// Never throws for the file's sake (std::bad_alloc aside).
-bool read_file(const std::string& path, size_t max_bytes, std::string* text, std::string* err);
+// Never throws for the file's sake (std::bad_alloc aside). stall_timeout_ms applies to
+// FIFOs and devices only (tests shorten it).
+bool read_file(const std::string& path, size_t max_bytes, std::string* text, std::string* err,
+               int stall_timeout_ms = kStallTimeoutMs);
 
 // "16 MiB" for whole mebibytes, else "N bytes": the limit as a message names it.
 std::string size_text(size_t bytes);

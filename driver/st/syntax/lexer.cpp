@@ -597,13 +597,9 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
     if (end < text_.size() && (text_[end] == '-' || text_[end] == '+')) ++end;
     while (end < text_.size() && (is_ident_char(text_[end]) || text_[end] == '.')) ++end;
     const common::DurationParse d = common::parse_duration_body(text_.substr(pos_, end - pos_));
-    if (d.ok()) {
-      value = d.ns;
-      pos_ = end;
-    } else {
-      fail(pos_ + d.error_at, d.error);
-      pos_ = end;
-    }
+    if (d.ok()) value = d.ns;
+    else fail(pos_ + d.error_at, d.error);
+    pos_ = end;
     lit = LiteralKind::Time;
   } else if (kind == TimePrefix::Date) {
     int64_t days = 0;

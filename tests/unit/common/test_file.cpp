@@ -2,6 +2,7 @@
 // path, and inputs that never end (devices, a FIFO fed forever) stopping fast at the limit.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -98,6 +99,24 @@ TEST_F(FileRead, FifoFedForeverStopsAtTheLimit) {
   EXPECT_LT(seconds_since(t0), 1.0);
   writer.join();
   std::signal(SIGPIPE, old);
+}
+
+TEST_F(FileRead, FifoWhoseWriterNeverWritesTimesOut) {
+  const std::string fifo = (dir_ / "silent").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::atomic<bool> done{false};
+  std::thread writer([&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);  // holds the pipe open, writes nothing
+    while (!done) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (fd >= 0) ::close(fd);
+  });
+  std::string text, err;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(read_file(fifo, kMiB, &text, &err, 200));
+  EXPECT_EQ(err, fifo + ": no data for 200 ms (a pipe nobody writes to?)");
+  EXPECT_LT(seconds_since(t0), 1.0);
+  done = true;
+  writer.join();
 }
 
 TEST_F(FileRead, FifoWithAFiniteWriterGivesItsText) {
