@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "common/file.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "journal.hpp"
 #include "plant_model/plant.hpp"
@@ -21,15 +22,6 @@
 #include "runtime/runtime.hpp"
 
 namespace plcfi::campaign {
-
-const char* outcome_name(Outcome o) {
-  switch (o) {
-    case Outcome::Pass: return "PASS";
-    case Outcome::Fail: return "FAIL";
-    case Outcome::NotReached: return "NOT REACHED";
-  }
-  return "?";
-}
 
 std::string campaign_fingerprint(const CampaignBuild& cb) {
   uint64_t h = 1469598103934665603ull;
@@ -43,8 +35,10 @@ std::string campaign_fingerprint(const CampaignBuild& cb) {
   mix(cb.spec.restart == RestartKind::Cold ? "cold" : "warm");
   mix(cb.spec.plant + "|" + cb.spec.plant_config);
   for (const auto& p : cb.spec.programs) {
-    std::ifstream in(p);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The programs compiled already, so they read; should one vanish since, its error
+    // text stands in (a different fingerprint, never a crash).
+    std::string text, read_err;
+    if (!common::read_file(p, common::kMaxSourceBytes, &text, &read_err)) text = read_err;
     mix(text);  // another program under test is another campaign
   }
   for (const auto& c : cb.cases) {

@@ -1,160 +1,55 @@
 // Results journal: writing, fsync per verdict, reading back for --resume.
 #include "journal.hpp"
 
-#include <cctype>
-#include <fstream>
-#include <map>
-#include <variant>
+#include <filesystem>
 
 #include <unistd.h>
 
 #include <fmt/format.h>
 
+#include "common/file.hpp"
+#include "common/json.hpp"
+
 namespace plcfi::campaign {
 
 namespace {
 
-std::string esc(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (c == '\n') out += "\\n";
-    else if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    else out += c;
-  }
-  return out;
+using common::Json;
+
+const std::string* get_str(const Json& o, const char* k) {
+  auto it = o.find(k);
+  return it == o.end() || !it->is_string() ? nullptr : it->get_ptr<const std::string*>();
 }
 
-// A flat JSON object as the journal writes it: string, integer or integer-array values.
-using Value = std::variant<std::string, int64_t, std::vector<int64_t>>;
-using Object = std::map<std::string, Value>;
-
-class LineParser {
- public:
-  explicit LineParser(const std::string& s) : s_(s) {}
-  bool parse(Object* out) {
-    ws();
-    if (!eat('{')) return false;
-    ws();
-    if (eat('}')) return true;
-    while (true) {
-      std::string key;
-      ws();
-      if (!str(&key)) return false;
-      ws();
-      if (!eat(':')) return false;
-      ws();
-      Value v;
-      if (peek() == '"') {
-        std::string x;
-        if (!str(&x)) return false;
-        v = x;
-      } else if (peek() == '[') {
-        ++i_;
-        std::vector<int64_t> arr;
-        ws();
-        if (!eat(']')) {
-          while (true) {
-            int64_t n;
-            ws();
-            if (!num(&n)) return false;
-            arr.push_back(n);
-            ws();
-            if (eat(']')) break;
-            if (!eat(',')) return false;
-          }
-        }
-        v = arr;
-      } else {
-        int64_t n;
-        if (!num(&n)) return false;
-        v = n;
-      }
-      (*out)[key] = v;
-      ws();
-      if (eat('}')) break;
-      if (!eat(',')) return false;
-    }
-    ws();
-    return i_ == s_.size();
-  }
-
- private:
-  char peek() const { return i_ < s_.size() ? s_[i_] : '\0'; }
-  bool eat(char c) {
-    if (peek() != c) return false;
-    ++i_;
-    return true;
-  }
-  void ws() {
-    while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
-  }
-  bool str(std::string* out) {
-    if (!eat('"')) return false;
-    while (i_ < s_.size() && s_[i_] != '"') {
-      char c = s_[i_++];
-      if (c == '\\') {
-        if (i_ >= s_.size()) return false;
-        char e = s_[i_++];
-        if (e == 'n') *out += '\n';
-        else if (e == 'u') {
-          if (i_ + 4 > s_.size()) return false;
-          int code = 0;
-          for (size_t k = 0; k < 4; ++k) {
-            char h = s_[i_ + k];
-            int d = std::isdigit(static_cast<unsigned char>(h)) ? h - '0'
-                    : (h >= 'a' && h <= 'f') ? h - 'a' + 10
-                    : (h >= 'A' && h <= 'F') ? h - 'A' + 10
-                                             : -1;
-            if (d < 0) return false;
-            code = code * 16 + d;
-          }
-          *out += static_cast<char>(code);
-          i_ += 4;
-        } else *out += e;
-      } else {
-        *out += c;
-      }
-    }
-    return eat('"');
-  }
-  bool num(int64_t* n) {
-    size_t b = i_;
-    if (peek() == '-') ++i_;
-    while (std::isdigit(static_cast<unsigned char>(peek()))) ++i_;
-    if (i_ == b || (i_ == b + 1 && s_[b] == '-')) return false;
-    try {
-      *n = std::stoll(s_.substr(b, i_ - b));
-    } catch (const std::exception&) {
-      return false;
-    }
-    return true;
-  }
-  const std::string& s_;
-  size_t i_ = 0;
-};
-
-const std::string* get_str(const Object& o, const char* k) {
+bool get_int(const Json& o, const char* k, int64_t* out) {
   auto it = o.find(k);
-  return it == o.end() ? nullptr : std::get_if<std::string>(&it->second);
-}
-const int64_t* get_int(const Object& o, const char* k) {
-  auto it = o.find(k);
-  return it == o.end() ? nullptr : std::get_if<int64_t>(&it->second);
+  if (it == o.end() || !it->is_number_integer()) return false;
+  *out = it->get<int64_t>();
+  return true;
 }
 
 }  // namespace
 
 std::string journal_line(const Execution& e, const TestCase& tc, const Progress& p) {
-  std::string br;
-  for (uint32_t b : e.branches) br += (br.empty() ? "" : ",") + std::to_string(b);
-  return fmt::format(
-      "{{\"case\":\"{}\",\"fmea\":\"{}\",\"transition\":\"{}\",\"path\":{},\"path_hash\":\"{:016x}\",\"branches\":[{}],"
-      "\"verdict\":\"{}\",\"reason\":\"{}\",\"run\":{},\"inject_ns\":{},\"start_ns\":{},\"reaction_ns\":{},\"end_ns\":{},"
-      "\"latency_ns\":{},\"vcd\":\"{}\",\"campaign_ns\":{},\"scans\":{}}}",
-      esc(e.case_id), esc(tc.row->id), esc(tc.transition_ref()), e.path, e.path_hash, br, outcome_name(e.outcome),
-      esc(e.reason), e.run, e.inject_ns, e.start_ns, e.reaction_ns, e.end_ns, e.latency_ns, esc(e.vcd), p.campaign_ns,
-      p.scans);
+  Json j;
+  j["case"] = e.case_id;
+  j["fmea"] = tc.row->id;
+  j["transition"] = tc.transition_ref();
+  j["path"] = e.path;
+  j["path_hash"] = fmt::format("{:016x}", e.path_hash);
+  j["branches"] = e.branches;
+  j["verdict"] = outcome_name(e.outcome);
+  j["reason"] = e.reason;
+  j["run"] = e.run;
+  j["inject_ns"] = e.inject_ns;
+  j["start_ns"] = e.start_ns;
+  j["reaction_ns"] = e.reaction_ns;
+  j["end_ns"] = e.end_ns;
+  j["latency_ns"] = e.latency_ns;
+  j["vcd"] = e.vcd;
+  j["campaign_ns"] = p.campaign_ns;
+  j["scans"] = p.scans;
+  return common::json_compact(j);
 }
 
 Journal::~Journal() {
@@ -174,22 +69,37 @@ bool Journal::open(const std::string& path, bool resume, const std::string& camp
                    const std::vector<TestCase>& cases, JournalState* state, std::string* err) {
   path_ = path;
   cases_ = &cases;
-  std::string header = fmt::format("{{\"journal\":\"plcfi campaign\",\"campaign\":\"{}\",\"fingerprint\":\"{}\",\"cases\":{}}}",
-                                    esc(campaign), fingerprint, cases.size());
-  std::ifstream in(path);
-  if (resume && in) {
-    std::string line, good;
+  Json head;
+  head["journal"] = "plcfi campaign";
+  head["campaign"] = campaign;
+  head["fingerprint"] = fingerprint;
+  head["cases"] = cases.size();
+  const std::string header = common::json_compact(head);
+  std::error_code ec;
+  if (resume && std::filesystem::exists(path, ec)) {
+    std::string text;
+    if (!common::read_file(path, common::kMaxJournalBytes, &text, err)) return false;
+    std::string good;
     uint32_t n = 0;
     bool torn = false;
-    while (std::getline(in, line)) {
+    for (size_t begin = 0; begin < text.size();) {
+      const size_t end = text.find('\n', begin);
       ++n;
-      if (in.eof()) {
+      if (end == std::string::npos) {
         torn = true;  // no newline: killed while writing this line
         break;
       }
-      Object o;
-      if (!LineParser(line).parse(&o)) {
-        *err = fmt::format("{}:{}:1: not a journal line", path, n);
+      const std::string line = text.substr(begin, end - begin);
+      begin = end + 1;
+      Json o;
+      std::string why;
+      size_t column = 1;
+      if (!common::json_parse(line, &o, &why, &column)) {
+        *err = fmt::format("{}:{}:{}: not a journal line ({})", path, n, column, why);
+        return false;
+      }
+      if (!o.is_object()) {
+        *err = fmt::format("{}:{}:1: not a journal line (expected a JSON object)", path, n);
         return false;
       }
       if (n == 1) {
@@ -231,25 +141,24 @@ bool Journal::open(const std::string& path, bool resume, const std::string& camp
         *err = fmt::format("{}:{}:1: path_hash '{}' is not hexadecimal", path, n, *hash);
         return false;
       }
-      if (const int64_t* v = get_int(o, "path")) e.path = static_cast<int>(*v);
-      if (auto it = o.find("branches"); it != o.end())
-        if (auto* arr = std::get_if<std::vector<int64_t>>(&it->second))
-          for (int64_t b : *arr) e.branches.push_back(static_cast<uint32_t>(b));
+      int64_t v = 0;
+      if (get_int(o, "path", &v)) e.path = static_cast<int>(v);
+      if (auto it = o.find("branches"); it != o.end() && it->is_array())
+        for (const auto& b : *it)
+          if (b.is_number_integer()) e.branches.push_back(b.get<uint32_t>());
       if (const std::string* s = get_str(o, "reason")) e.reason = *s;
       if (const std::string* s = get_str(o, "vcd")) e.vcd = *s;
       std::pair<const char*, int64_t*> ints[] = {{"inject_ns", &e.inject_ns}, {"start_ns", &e.start_ns},
                                                  {"reaction_ns", &e.reaction_ns}, {"end_ns", &e.end_ns},
                                                  {"latency_ns", &e.latency_ns}};
-      for (auto& [k, dst] : ints)
-        if (const int64_t* v = get_int(o, k)) *dst = *v;
-      if (const int64_t* v = get_int(o, "run")) e.run = static_cast<uint64_t>(*v);
+      for (auto& [k, dst] : ints) get_int(o, k, dst);
+      if (get_int(o, "run", &v)) e.run = static_cast<uint64_t>(v);
       state->executions.push_back(e);
       state->next_run = e.run + 1;
-      if (const int64_t* v = get_int(o, "campaign_ns")) state->campaign_ns = *v;
-      if (const int64_t* v = get_int(o, "scans")) state->scans = static_cast<uint64_t>(*v);
+      get_int(o, "campaign_ns", &state->campaign_ns);
+      if (get_int(o, "scans", &v)) state->scans = static_cast<uint64_t>(v);
       good += line + "\n";
     }
-    in.close();
     if (n == 0 || (n == 1 && torn)) {
       // Empty or only a torn header: start afresh.
       state->executions.clear();

@@ -1,14 +1,16 @@
 // The results journal (results.jsonl): a header line naming the campaign, then one JSON
 // object per verdict, appended and flushed to disk (fsync) as each test ends, so a killed
 // campaign resumes where it stopped without re-running or duplicating a finished case.
-// No wall-clock values: the same campaign and seed give an identical journal.
+// No wall-clock values: the same campaign and seed give an identical journal. The lines are
+// JSON (nlohmann-json, common/json.hpp) with the fields in a fixed order.
 #pragma once
 
 #include <cstdio>
 #include <string>
 #include <vector>
 
-#include "driver.hpp"
+#include "execution.hpp"
+#include "generate.hpp"
 
 namespace plcfi::campaign {
 

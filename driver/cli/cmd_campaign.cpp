@@ -136,19 +136,34 @@ void print_cases(const CampaignBuild& cb) {
   }
 }
 
+// Milliseconds as JSON: an integer when whole (600, not 600.0), else a fraction.
+Json json_ms(int64_t ns) {
+  if (ns % 1'000'000 == 0) return ns / 1'000'000;
+  return static_cast<double>(ns) * 1e-6;
+}
+
+// One case per line, in a JSON array.
 std::string json_cases(const CampaignBuild& cb) {
   std::string o = "[\n";
   for (size_t i = 0; i < cb.cases.size(); ++i) {
     const auto& tc = cb.cases[i];
-    o += fmt::format(
-        "  {{\"id\": \"{}\", \"fmea\": \"{}\", \"rpn\": {}, \"fault_class\": \"{}\", \"transition\": \"{}\", "
-        "\"failure_mode\": \"{}\", \"precondition\": \"{}\", \"start\": \"{}\", \"target\": \"{}\", \"address\": \"{}\", "
-        "\"fault\": \"{}\", \"alarm\": \"{}\", \"expected\": \"{}\", \"deadline_ms\": {}, \"max_duration_ms\": {}}}{}\n",
-        json_escape(tc.id), json_escape(tc.row->id), tc.rpn, json_escape(tc.cls->id), json_escape(tc.transition_ref()),
-        json_escape(tc.row->failure_mode), json_escape(tc.precondition), json_escape(tc.start), json_escape(tc.target->name),
-        json_escape(tc.target_ref.text), json_escape(tc.fault.text), json_escape(tc.row->alarm), json_escape(tc.expected),
-        static_cast<double>(tc.deadline_ns) * 1e-6, static_cast<double>(tc.max_duration_ns) * 1e-6,
-        i + 1 < cb.cases.size() ? "," : "");
+    Json j;
+    j["id"] = tc.id;
+    j["fmea"] = tc.row->id;
+    j["rpn"] = tc.rpn;
+    j["fault_class"] = tc.cls->id;
+    j["transition"] = tc.transition_ref();
+    j["failure_mode"] = tc.row->failure_mode;
+    j["precondition"] = tc.precondition;
+    j["start"] = tc.start;
+    j["target"] = tc.target->name;
+    j["address"] = tc.target_ref.text;
+    j["fault"] = tc.fault.text;
+    j["alarm"] = tc.row->alarm;
+    j["expected"] = tc.expected;
+    j["deadline_ms"] = json_ms(tc.deadline_ns);
+    j["max_duration_ms"] = json_ms(tc.max_duration_ns);
+    o += "  " + json_line(j) + (i + 1 < cb.cases.size() ? ",\n" : "\n");
   }
   return o + "]\n";
 }

@@ -15,23 +15,30 @@ namespace po = boost::program_options;
 
 namespace plcfi::cli {
 
-std::string verdicts_json(const std::vector<monitor::Verdict>& vs) {
-  std::string out = "[";
-  for (size_t i = 0; i < vs.size(); ++i) {
-    const auto& v = vs[i];
-    out += fmt::format("{}{{\"id\": \"{}\", \"text\": \"{}\", \"verdict\": \"{}\", \"triggers\": {}, \"held\": {}, \"violated\": {}, "
-                       "\"pending\": {}, \"violations\": [",
-                       i ? ", " : "", json_escape(v.id), json_escape(v.text), v.violated() ? "VIOLATED" : "SATISFIED", v.triggers,
-                       v.holds, v.violated_instances, v.pending);
-    for (size_t k = 0; k < v.violations.size(); ++k) {
-      const auto& x = v.violations[k];
-      out += fmt::format("{}{{\"trigger_state\": {}, \"trigger_time\": {:.9f}, \"state\": {}, \"time\": {:.9f}, \"cause\": \"{}\"}}",
-                         k ? ", " : "", x.trigger_state, static_cast<double>(x.trigger_time_ns) * 1e-9, x.state,
-                         static_cast<double>(x.time_ns) * 1e-9, x.cause == monitor::Cause::Invariant ? "invariant" : "delay");
+Json verdicts_json(const std::vector<monitor::Verdict>& vs) {
+  Json out = Json::array();
+  for (const auto& v : vs) {
+    Json r;
+    r["id"] = v.id;
+    r["text"] = v.text;
+    r["verdict"] = v.violated() ? "VIOLATED" : "SATISFIED";
+    r["triggers"] = v.triggers;
+    r["held"] = v.holds;
+    r["violated"] = v.violated_instances;
+    r["pending"] = v.pending;
+    r["violations"] = Json::array();
+    for (const auto& x : v.violations) {
+      Json w;
+      w["trigger_state"] = x.trigger_state;
+      w["trigger_time"] = static_cast<double>(x.trigger_time_ns) * 1e-9;
+      w["state"] = x.state;
+      w["time"] = static_cast<double>(x.time_ns) * 1e-9;
+      w["cause"] = x.cause == monitor::Cause::Invariant ? "invariant" : "delay";
+      r["violations"].push_back(std::move(w));
     }
-    out += "]}";
+    out.push_back(std::move(r));
   }
-  return out + "]";
+  return out;
 }
 
 bool write_verdicts_junit(const std::string& path, const std::string& suite, const std::vector<monitor::Verdict>& vs,
@@ -105,8 +112,11 @@ int cmd_edtl(const std::vector<std::string>& args) {
   uint64_t state = result.states;
   const auto& verdicts = result.verdicts;
   if (vm.count("json")) {
-    std::cout << fmt::format("{{\"trace\": \"{}\", \"states\": {}, \"requirements\": {}}}\n", json_escape(files[1]), state,
-                             verdicts_json(verdicts));
+    Json j;
+    j["trace"] = files[1];
+    j["states"] = state;
+    j["requirements"] = verdicts_json(verdicts);
+    std::cout << json_line(j) << "\n";
   } else {
     std::cout << fmt::format("{}: {} states\n", files[1], state) << monitor::format_verdicts(verdicts);
   }

@@ -60,12 +60,12 @@ std::unique_ptr<st::Build> load(const std::vector<std::string>& files, const st:
 }
 
 
-std::string json_value(const st::Machine& m, const st::VarHandle& h) {
+Json json_value(const st::Machine& m, const st::VarHandle& h) {
   const st::Type* t = h.type;
-  if (h.is_bit || t->kind == st::TypeKind::Bool) return st::read_bool(m, h) ? "true" : "false";
-  if (t->is_integer() || t->is_bitstring()) return std::to_string(st::read_int(m, h));
-  if (t->is_real()) return fmt::format("{}", st::read_real(m, h));
-  return "\"" + json_escape(st::format(m, h)) + "\"";
+  if (h.is_bit || t->kind == st::TypeKind::Bool) return st::read_bool(m, h);
+  if (t->is_integer() || t->is_bitstring()) return st::read_int(m, h);
+  if (t->is_real()) return st::read_real(m, h);
+  return st::format(m, h);
 }
 
 }  // namespace
@@ -254,12 +254,14 @@ int cmd_run(const std::vector<std::string>& args) {
   }
   if (!trap_text.empty()) std::cerr << trap_text << "\n";
   if (vm.count("json")) {
-    std::string out = fmt::format("{{\"cycles\": {}, \"time_ns\": {}, \"tick_ns\": {}, \"trap\": {}, \"values\": {{", done,
-                                  static_cast<int64_t>(done) * sched.tick_ns(), sched.tick_ns(),
-                                  trap_text.empty() ? "null" : "\"" + json_escape(trap_text) + "\"");
-    for (size_t i = 0; i < prints.size(); ++i)
-      out += fmt::format("{}\"{}\": {}", i ? ", " : "", json_escape(prints[i].path), json_value(m, prints[i]));
-    std::cout << out << "}}\n";
+    Json j;
+    j["cycles"] = done;
+    j["time_ns"] = static_cast<int64_t>(done) * sched.tick_ns();
+    j["tick_ns"] = sched.tick_ns();
+    j["trap"] = trap_text.empty() ? Json(nullptr) : Json(trap_text);
+    j["values"] = Json::object();
+    for (const auto& h : prints) j["values"][h.path] = json_value(m, h);
+    std::cout << json_line(j) << "\n";
   } else {
     for (const auto& h : prints) std::cout << h.path << " = " << st::format(m, h) << "\n";
   }

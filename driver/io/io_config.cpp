@@ -2,12 +2,10 @@
 #include "io_config.hpp"
 
 #include <cctype>
-#include <fstream>
 
 #include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
 
-#include "runtime/schedule.hpp"
+#include "common/yaml.hpp"
 
 namespace plcfi::io {
 
@@ -42,50 +40,19 @@ const char* drive_name(GpioDrive d) {
 
 namespace {
 
-struct Fail {
-  std::string message;
-};
-
+// The io section's reader: the shared strict YAML getters (common/yaml.hpp) plus the
+// image addresses and overlap checks of this file.
 class Reader {
  public:
-  Reader(std::string path, const st::Application& app) : path_(std::move(path)), app_(app) {}
+  Reader(const common::YamlDoc& doc, const st::Application& app) : doc_(doc), app_(app) {}
 
-  std::string at(const YAML::Node& n) const { return fmt::format("{}:{}:{}", path_, n.Mark().line + 1, n.Mark().column + 1); }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& m) const { throw Fail{at(n) + ": " + m}; }
-  std::string str(const YAML::Node& n, const char* what) const {
-    if (!n.IsScalar()) fail(n, std::string(what) + " must be a single value");
-    return n.Scalar();
-  }
-  int64_t integer(const YAML::Node& n, const char* what, int64_t lo, int64_t hi) const {
-    std::string s = str(n, what);
-    try {
-      size_t used = 0;
-      long long v = std::stoll(s, &used, 0);
-      if (used != s.size()) throw std::invalid_argument(s);
-      if (v < lo || v > hi) fail(n, fmt::format("{} {} is outside {}..{}", what, v, lo, hi));
-      return v;
-    } catch (const std::exception&) {
-      fail(n, fmt::format("{}: '{}' is not an integer", what, s));
-    }
-  }
-  int64_t duration(const YAML::Node& n, const char* what) const {
-    std::string e;
-    int64_t ns = 0;
-    if (!rt::parse_duration(str(n, what), &ns, &e)) fail(n, std::string(what) + ": " + e);
-    if (ns <= 0) fail(n, std::string(what) + " must be positive");
-    return ns;
-  }
-  void keys(const YAML::Node& m, std::initializer_list<const char*> allowed, const char* what) const {
-    if (!m.IsMap()) fail(m, std::string(what) + " must be a map");
-    for (const auto& kv : m) {
-      bool ok = false;
-      for (const char* a : allowed) ok = ok || kv.first.Scalar() == a;
-      if (!ok) {
-        std::string list;
-        for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-        fail(kv.first, fmt::format("unknown key '{}' in {} (expected one of: {})", kv.first.Scalar(), what, list));
-      }
-    }
+  std::string at(const YAML::Node& n) const { return doc_.where(n); }
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& m) const { doc_.fail(n, m); }
+  std::string str(const YAML::Node& n, const char* what) const { return doc_.scalar(n, what); }
+  int64_t integer(const YAML::Node& n, const char* what, int64_t lo, int64_t hi) const { return doc_.integer(n, what, lo, hi); }
+  int64_t duration(const YAML::Node& n, const char* what) const { return doc_.duration(n, what, 1); }
+  void keys(const YAML::Node& m, std::initializer_list<std::string_view> allowed, const char* what) const {
+    doc_.check_keys(m, allowed, what);
   }
   rt::ImageRef image(const YAML::Node& n, const char* what) const {
     rt::ImageRef r;
@@ -95,9 +62,8 @@ class Reader {
   }
 
   void device(const YAML::Node& n, IoConfig* cfg) {
-    if (!n.IsMap()) fail(n, "a device must be a map (name:, and tcp:, rtu: or gpio:)");
-    if (!n["name"]) fail(n, "a device needs a name");
-    std::string name = str(n["name"], "name");
+    if (!n.IsMap()) fail(n, "a device: expected a map (name:, and tcp:, rtu: or gpio:), got " + common::YamlDoc::describe(n));
+    std::string name = str(doc_.required(n, "name", "a device"), "name");
     for (const auto& other : cfg->devices)
       if (other.name == name) fail(n["name"], "device '" + name + "' is defined twice");
     for (const auto& other : cfg->gpio_devices)
@@ -143,21 +109,12 @@ class Reader {
       const YAML::Node r = n["rtu"];
       keys(r, {"device", "baud", "parity", "data_bits", "stop_bits", "mode"}, "rtu");
       d.rtu = true;
-      if (!r["device"]) fail(r, "rtu needs a device (e.g. /dev/ttyUSB0)");
-      d.device = str(r["device"], "device");
+      d.device = str(doc_.required(r, "device", "rtu"), "device");
       if (r["baud"]) d.baud = static_cast<int>(integer(r["baud"], "baud", 50, 4'000'000));
-      if (r["parity"]) {
-        std::string p = str(r["parity"], "parity");
-        if (p != "N" && p != "E" && p != "O") fail(r["parity"], "parity must be N, E or O");
-        d.parity = p[0];
-      }
+      if (r["parity"]) d.parity = doc_.word(r["parity"], "parity", {"N", "E", "O"})[0];
       if (r["data_bits"]) d.data_bits = static_cast<int>(integer(r["data_bits"], "data_bits", 5, 8));
       if (r["stop_bits"]) d.stop_bits = static_cast<int>(integer(r["stop_bits"], "stop_bits", 1, 2));
-      if (r["mode"]) {
-        std::string m = str(r["mode"], "mode");
-        if (m != "rs232" && m != "rs485") fail(r["mode"], "mode must be rs232 or rs485");
-        d.rs485 = m == "rs485";
-      }
+      if (r["mode"]) d.rs485 = doc_.word(r["mode"], "mode", {"rs232", "rs485"}) == "rs485";
     }
     if (n["unit"]) d.unit = static_cast<int>(integer(n["unit"], "unit", 0, 247));
     if (n["timeout"]) d.timeout_ns = duration(n["timeout"], "timeout");
@@ -191,14 +148,11 @@ class Reader {
     GpioPoint p;
     p.where = at(n);
     p.device = device;
-    if (!n["image"]) fail(n, "a mapping needs image: (the first %IX/%QX bit)");
-    p.image = image(n["image"], "image");
+    p.image = image(doc_.required(n, "image", "a GPIO mapping"), "image");
     if (!p.image.is_bit || (p.image.area != 'I' && p.image.area != 'Q'))
       fail(n["image"], "GPIO lines map to bits: %IXn.m (inputs) or %QXn.m (outputs)");
-    const YAML::Node lines = n["lines"];
-    if (!lines) fail(n, "a GPIO mapping needs lines: [offsets or line names]");
-    if (lines.IsScalar()) fail(lines, "lines is a list, e.g. [0, 1, 2] or [START, STOP]");
-    if (!lines.IsSequence() || lines.size() == 0) fail(lines, "lines is a non-empty list of offsets or line names");
+    const YAML::Node lines = doc_.required(n, "lines", "a GPIO mapping");
+    doc_.list(lines, "lines");
     if (lines.size() > 64) fail(lines, "at most 64 lines per mapping (one bulk request)");
     for (const auto& l : lines) {
       GpioPoint::Line line;
@@ -220,27 +174,20 @@ class Reader {
           fail(l, "line " + t + " is listed twice");
       p.lines.push_back(line);
     }
-    if (n["active_low"]) {
-      std::string v = str(n["active_low"], "active_low");
-      if (v == "true" || v == "TRUE") p.active_low = true;
-      else if (v == "false" || v == "FALSE") p.active_low = false;
-      else fail(n["active_low"], "active_low is true or false");
-    }
+    if (n["active_low"]) p.active_low = doc_.boolean(n["active_low"], "active_low");
     if (n["bias"]) {
-      std::string v = str(n["bias"], "bias");
+      std::string v = doc_.word(n["bias"], "bias", {"as-is", "disabled", "pull-up", "pull-down"});
       if (v == "as-is") p.bias = GpioBias::AsIs;
       else if (v == "disabled") p.bias = GpioBias::Disabled;
       else if (v == "pull-up") p.bias = GpioBias::PullUp;
-      else if (v == "pull-down") p.bias = GpioBias::PullDown;
-      else fail(n["bias"], "bias is as-is, disabled, pull-up or pull-down");
+      else p.bias = GpioBias::PullDown;
       if (p.image.area == 'Q') fail(n["bias"], "bias applies to inputs (%IX)");
     }
     if (n["drive"]) {
-      std::string v = str(n["drive"], "drive");
+      std::string v = doc_.word(n["drive"], "drive", {"push-pull", "open-drain", "open-source"});
       if (v == "push-pull") p.drive = GpioDrive::PushPull;
       else if (v == "open-drain") p.drive = GpioDrive::OpenDrain;
-      else if (v == "open-source") p.drive = GpioDrive::OpenSource;
-      else fail(n["drive"], "drive is push-pull, open-drain or open-source");
+      else p.drive = GpioDrive::OpenSource;
       if (p.image.area == 'I') fail(n["drive"], "drive applies to outputs (%QX)");
     }
     uint32_t area_size = p.image.area == 'I' ? app_.image_i.size : app_.image_q.size;
@@ -252,16 +199,14 @@ class Reader {
   }
 
   void point(const YAML::Node& n, IoConfig* cfg) {
-    if (!n.IsMap()) fail(n, "a mapping must be a map (image:, device:, ...)");
-    if (!n["device"]) fail(n, "a mapping needs a device");
-    std::string dev = str(n["device"], "device");
+    if (!n.IsMap()) fail(n, "a mapping: expected a map (image:, device:, ...), got " + common::YamlDoc::describe(n));
+    std::string dev = str(doc_.required(n, "device", "a mapping"), "device");
     for (size_t i = 0; i < cfg->gpio_devices.size(); ++i)
       if (cfg->gpio_devices[i].name == dev) return gpio_point(n, i, cfg);
     keys(n, {"image", "count", "device", "coils", "discrete_inputs", "holding_registers", "input_registers"}, "a mapping");
     ModbusPoint p;
     p.where = at(n);
-    if (!n["image"]) fail(n, "a mapping needs image: (the first %I/%Q address)");
-    p.image = image(n["image"], "image");
+    p.image = image(doc_.required(n, "image", "a mapping"), "image");
     if (n["count"]) p.count = static_cast<int>(integer(n["count"], "count", 1, 2000));
     p.device = SIZE_MAX;
     for (size_t i = 0; i < cfg->devices.size(); ++i)
@@ -303,7 +248,7 @@ class Reader {
     uint64_t bit0, bit1;
     std::string where;
   };
-  std::string path_;
+  const common::YamlDoc& doc_;
   const st::Application& app_;
   std::vector<Range> ranges_;
 };
@@ -311,31 +256,18 @@ class Reader {
 }  // namespace
 
 bool load_io_config(const std::string& path, const st::Application& app, IoConfig* out, std::string* err) {
-  std::ifstream in(path);
-  if (!in) {
-    *err = path + ": cannot open";
-    return false;
-  }
-  YAML::Node root;
-  try {
-    root = YAML::Load(in);
-  } catch (const YAML::Exception& e) {
-    *err = fmt::format("{}:{}:{}: {}", path, e.mark.line + 1, e.mark.column + 1, e.msg);
-    return false;
-  }
   out->path = path;
-  Reader r(path, app);
-  try {
+  return common::catch_input_error(err, [&] {
+    const common::YamlDoc doc = common::YamlDoc::open(path);
+    const YAML::Node& root = doc.root();
+    Reader r(doc, app);
     YAML::Node io = root.IsMap() && root["io"] ? root["io"] : root;
     r.keys(io, {"devices", "map", "safe_state"}, "the io section");
-    const YAML::Node devs = io["devices"];
-    if (!devs || !devs.IsSequence() || devs.size() == 0) r.fail(io, "io needs a list of devices");
-    for (const auto& d : devs) r.device(d, out);
-    const YAML::Node map = io["map"];
-    if (!map || !map.IsSequence() || map.size() == 0) r.fail(io, "io needs a map: list of image ranges");
-    for (const auto& p : map) r.point(p, out);
+    for (const auto& d : doc.list(doc.required(io, "devices", "the io section"), "devices")) r.device(d, out);
+    for (const auto& p : doc.list(doc.required(io, "map", "the io section"), "map (image ranges)")) r.point(p, out);
     if (const YAML::Node safe = io["safe_state"]) {
-      if (!safe.IsMap()) r.fail(safe, "safe_state maps outputs to values, e.g. {\"%QX0.0\": TRUE}");
+      if (!safe.IsMap()) r.fail(safe, "safe_state: expected a map of outputs to values, e.g. {\"%QX0.0\": TRUE}, got " +
+                                          common::YamlDoc::describe(safe));
       for (const auto& kv : safe) {
         rt::ImageRef ref = r.image(kv.first, "safe_state");
         if (ref.area != 'Q') r.fail(kv.first, "safe_state lists outputs (%Q)");
@@ -347,11 +279,7 @@ bool load_io_config(const std::string& path, const st::Application& app, IoConfi
         out->safe_state.emplace_back(ref, x);
       }
     }
-  } catch (const Fail& f) {
-    *err = f.message;
-    return false;
-  }
-  return true;
+  });
 }
 
 }  // namespace plcfi::io

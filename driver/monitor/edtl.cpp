@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
-#include <fstream>
 
 #include <fmt/format.h>
-#include <yaml-cpp/yaml.h>
+
+#include "common/yaml.hpp"
 
 #include "trace_reader.hpp"
 
@@ -17,105 +17,55 @@ namespace plcfi::monitor {
 
 namespace {
 
-std::string where(const std::string& path, const YAML::Mark& m) {
-  return fmt::format("{}:{}:{}", path, m.line + 1, m.column + 1);
+FormulaSource read_formula(const common::YamlDoc& doc, const YAML::Node& node, std::string_view key) {
+  FormulaSource f;
+  f.text = doc.scalar(node, std::string(key) + " (an ST expression)");
+  f.line = doc.line(node);
+  f.col = doc.text_col(node);  // quoted: the formula starts after the quote
+  return f;
 }
 
-bool read_formula(const std::string& path, const YAML::Node& node, FormulaSource* f, std::string* err) {
-  if (!node.IsScalar()) {
-    *err = where(path, node.Mark()) + ": a formula must be a string (an ST expression)";
-    return false;
-  }
-  f->text = node.Scalar();
-  f->line = static_cast<uint32_t>(node.Mark().line + 1);
-  f->col = static_cast<uint32_t>(node.Mark().column + 1);
-  // Quoted scalars start one column after the quote.
-  if (node.Tag() == "!") f->col += 1;
-  return true;
-}
-
-}  // namespace
-
-bool load_requirements(const std::string& path, RequirementsFile* out, std::string* err) {
-  std::ifstream in(path);
-  if (!in) {
-    *err = path + ": cannot open";
-    return false;
-  }
-  YAML::Node root;
-  try {
-    root = YAML::Load(in);
-  } catch (const YAML::Exception& e) {
-    *err = where(path, e.mark) + ": " + e.msg;
-    return false;
-  }
-  out->path = path;
+void read_requirements(const common::YamlDoc& doc, RequirementsFile* out) {
+  const YAML::Node& root = doc.root();
   YAML::Node list = root;
   if (root.IsMap()) {
-    for (const auto& kv : root)
-      if (kv.first.Scalar() != "requirements") {
-        *err = where(path, kv.first.Mark()) + ": unknown key '" + kv.first.Scalar() + "' (expected 'requirements')";
-        return false;
-      }
-    list = root["requirements"];
+    doc.check_keys(root, {"requirements"}, "a requirements file");
+    list = doc.required(root, "requirements", "a requirements file");
+  } else if (!root.IsSequence()) {
+    doc.fail(root, "a requirements file: expected a list of requirements (or a map with the key 'requirements'), got " +
+                       common::YamlDoc::describe(root));
   }
-  if (!list || !list.IsSequence()) {
-    *err = path + ":1:1: expected a list of requirements (or a map with the key 'requirements')";
-    return false;
-  }
-  static const char* kKeys[] = {"id", "text", "severity", "trigger", "invariant", "final", "delay", "reaction", "release"};
-  for (const auto& item : list) {
-    if (!item.IsMap()) {
-      *err = where(path, item.Mark()) + ": a requirement is a map with id, text and the formulas";
-      return false;
-    }
+  for (const auto& item : doc.list(list, "requirements")) {
+    doc.check_keys(item, {"id", "text", "severity", "trigger", "invariant", "final", "delay", "reaction", "release"},
+                   "a requirement");
     RequirementSpec r;
-    r.line = static_cast<uint32_t>(item.Mark().line + 1);
+    r.line = doc.line(item);
+    r.id = doc.scalar(doc.required(item, "id", "a requirement"), "id");
+    if (r.id.empty()) doc.fail(item["id"], "id: expected a name, got nothing");
+    for (const auto& other : out->requirements)
+      if (other.id == r.id) doc.fail(item["id"], "requirement id '" + r.id + "' is used twice");
+    if (item["text"]) r.text = doc.scalar(item["text"], "text");
+    if (item["severity"]) r.severity = doc.scalar(item["severity"], "severity");
+    r.trigger = read_formula(doc, doc.required(item, "trigger", "requirement '" + r.id + "'"), "trigger");
     r.invariant.text = "TRUE";
     r.final.text = "TRUE";
     r.delay.text = "TRUE";
     r.reaction.text = "TRUE";
     r.release.text = "FALSE";
-    for (const auto& kv : item) {
-      std::string key = kv.first.Scalar();
-      if (std::find(std::begin(kKeys), std::end(kKeys), key) == std::end(kKeys)) {
-        *err = where(path, kv.first.Mark()) + ": unknown key '" + key +
-               "' (expected id, text, severity, trigger, invariant, final, delay, reaction, release)";
-        return false;
-      }
-      const YAML::Node& v = kv.second;
-      if (key == "id" || key == "text" || key == "severity") {
-        if (!v.IsScalar()) {
-          *err = where(path, v.Mark()) + ": '" + key + "' must be a string";
-          return false;
-        }
-        (key == "id" ? r.id : key == "text" ? r.text : r.severity) = v.Scalar();
-        continue;
-      }
-      FormulaSource* f = key == "trigger" ? &r.trigger : key == "invariant" ? &r.invariant : key == "final" ? &r.final
-                         : key == "delay" ? &r.delay : key == "reaction" ? &r.reaction : &r.release;
-      if (!read_formula(path, v, f, err)) return false;
-    }
-    if (r.id.empty()) {
-      *err = where(path, item.Mark()) + ": requirement without an 'id'";
-      return false;
-    }
-    if (r.trigger.line == 0) {
-      *err = where(path, item.Mark()) + ": requirement '" + r.id + "' has no trigger";
-      return false;
-    }
-    for (const auto& other : out->requirements)
-      if (other.id == r.id) {
-        *err = where(path, item.Mark()) + ": requirement id '" + r.id + "' is used twice";
-        return false;
-      }
+    const std::pair<const char*, FormulaSource*> optional[] = {{"invariant", &r.invariant}, {"final", &r.final},
+                                                                {"delay", &r.delay},         {"reaction", &r.reaction},
+                                                                {"release", &r.release}};
+    for (const auto& [key, dst] : optional)
+      if (item[key]) *dst = read_formula(doc, item[key], key);
     out->requirements.push_back(std::move(r));
   }
-  if (out->requirements.empty()) {
-    *err = path + ":1:1: no requirements";
-    return false;
-  }
-  return true;
+}
+
+}  // namespace
+
+bool load_requirements(const std::string& path, RequirementsFile* out, std::string* err) {
+  out->path = path;
+  return common::catch_input_error(err, [&] { read_requirements(common::YamlDoc::open(path), out); });
 }
 
 // ------------------------------------------------------------------ translation

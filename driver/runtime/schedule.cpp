@@ -1,12 +1,12 @@
-// Task schedule construction and duration parsing for command-line options.
+// Task schedule construction, and the duration reading of command-line options.
 #include "schedule.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cctype>
 #include <numeric>
 
+#include "common/duration.hpp"
 #include "syntax/source.hpp"
 
 namespace plcfi::rt {
@@ -57,58 +57,14 @@ void Schedule::finish() {
   std::stable_sort(tasks_.begin(), tasks_.end(), [](const auto& a, const auto& b) { return a.priority < b.priority; });
 }
 
-bool parse_duration(const std::string& text_in, int64_t* ns, std::string* err) {
-  std::string text = st::canon(text_in);
-  if (text.rfind("T#", 0) == 0) text = text.substr(2);
-  else if (text.rfind("TIME#", 0) == 0) text = text.substr(5);
-  if (text.empty()) {
-    *err = "empty duration";
+bool parse_duration(const std::string& text, int64_t* ns, std::string* err) {
+  int64_t v = 0;
+  if (!common::parse_duration(text, &v, err)) return false;
+  if (v < 0) {
+    *err = "'" + text + "': a duration here must not be negative";
     return false;
   }
-  int64_t total = 0;
-  size_t i = 0;
-  bool any = false;
-  while (i < text.size()) {
-    if (text[i] == '_') {
-      ++i;
-      continue;
-    }
-    size_t j = i;
-    while (j < text.size() && (std::isdigit(static_cast<unsigned char>(text[j])) || text[j] == '.')) ++j;
-    if (j == i) {
-      *err = "'" + text_in + "' is not a duration (e.g. 10ms, 1s, 2m30s)";
-      return false;
-    }
-    double value = std::stod(text.substr(i, j - i));
-    size_t k = j;
-    while (k < text.size() && std::isalpha(static_cast<unsigned char>(text[k]))) ++k;
-    std::string unit = text.substr(j, k - j);
-    double mul = 0;
-    if (unit == "D") mul = 86400e9;
-    else if (unit == "H") mul = 3600e9;
-    else if (unit == "M") mul = 60e9;
-    else if (unit == "S") mul = 1e9;
-    else if (unit == "MS") mul = 1e6;
-    else if (unit == "US") mul = 1e3;
-    else if (unit == "NS") mul = 1;
-    else {
-      *err = "'" + text_in + "': unknown unit '" + unit + "' (use d, h, m, s, ms, us, ns)";
-      return false;
-    }
-    double v = value * mul;
-    if (v > 9.2e18) {
-      *err = "'" + text_in + "' is too long";
-      return false;
-    }
-    total += static_cast<int64_t>(v);
-    any = true;
-    i = k;
-  }
-  if (!any) {
-    *err = "'" + text_in + "' is not a duration";
-    return false;
-  }
-  *ns = total;
+  *ns = v;
   return true;
 }
 

@@ -40,7 +40,9 @@ class Schedule {
   std::vector<ScheduledTask> tasks_;
 };
 
-// Parses "10ms", "1s", "500us", "2m", "1h30m", "T#10ms" into nanoseconds.
+// Parses "10ms", "1s", "500us", "2m", "1h30m", "T#10ms" into nanoseconds with the one
+// duration parser (common/duration.hpp); a negative value is an error here, as no option
+// or spec value takes one. *err: "'TEXT' is not a duration: DETAIL".
 bool parse_duration(const std::string& text, int64_t* ns, std::string* err);
 
 }  // namespace plcfi::rt

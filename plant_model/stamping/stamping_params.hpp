@@ -53,7 +53,8 @@ struct StampingParams {
 };
 
 // Reads a YAML parameter file over the defaults. On error returns false and sets err to
-// "FILE:LINE:COL: message" (1-based), or "FILE: cannot open" for a missing file.
+// "FILE:LINE:COL: message" (1-based; the wording of common/yaml.hpp), or a file error
+// ("FILE: cannot open (REASON)", "FILE: is a directory", ...).
 bool load_stamping_params(const std::string& path, StampingParams* params, std::string* err);
 
 }  // namespace plcfi::plant

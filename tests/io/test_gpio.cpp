@@ -127,18 +127,18 @@ TEST_F(GpioConfig, ErrorsNameLineAndColumn) {
   EXPECT_EQ(error_of(head + "    - {image: \"%IW2\", device: board, lines: [0]}\n"),
             "5:15: GPIO lines map to bits: %IXn.m (inputs) or %QXn.m (outputs)");
   EXPECT_EQ(error_of(head + "    - {image: \"%IX0.0\", device: board, lines: 3}\n"),
-            "5:47: lines is a list, e.g. [0, 1, 2] or [START, STOP]");
+            "5:47: lines: expected a list, got '3'");
   EXPECT_EQ(error_of(head + "    - {image: \"%IX0.0\", device: board, lines: [0, 0]}\n"), "5:51: line 0 is listed twice");
   std::string twice = error_of(head + "    - {image: \"%IX0.0\", device: board, lines: [0]}\n    - {image: \"%IX0.1\", device: board, lines: [0]}\n");
   EXPECT_EQ(twice, "6:48: line 0 is already mapped at " + path_ + ":5:7");
   EXPECT_EQ(error_of(head + "    - {image: \"%IX0.0\", device: board, lines: [0], bias: up}\n"),
-            "5:58: bias is as-is, disabled, pull-up or pull-down");
+            "5:58: bias: expected as-is, disabled, pull-up or pull-down, got 'up'");
   EXPECT_EQ(error_of(head + "    - {image: \"%QX0.0\", device: board, lines: [0], bias: pull-up}\n"),
             "5:58: bias applies to inputs (%IX)");
   EXPECT_EQ(error_of(head + "    - {image: \"%IX0.0\", device: board, lines: [0], drive: open-drain}\n"),
             "5:59: drive applies to outputs (%QX)");
   EXPECT_EQ(error_of(head + "    - {image: \"%IX0.0\", device: board, lines: [0], active_low: maybe}\n"),
-            "5:64: active_low is true or false");
+            "5:64: active_low: expected true or false, got 'maybe'");
   EXPECT_EQ(error_of(head + "    - {image: \"%IX0.0\", device: board, lines: [0], count: 2}\n"),
             "5:52: unknown key 'count' in a GPIO mapping (expected one of: image, device, lines, active_low, bias, drive)");
   std::string overlap = error_of(head + "    - {image: \"%IX0.0\", device: board, lines: [0, 1]}\n    - {image: \"%IX0.1\", device: board, lines: [2]}\n");

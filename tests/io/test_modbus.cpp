@@ -137,11 +137,11 @@ TEST_F(ModbusIo, IoSectionErrorsNameTheLine) {
                         Case{dev + "    - {image: \"%QX0.0\", device: d, discrete_inputs: 0}\n", ":5:15: discrete_inputs are read-only"},
                         Case{dev + "    - {image: \"%IX0.0\", device: e, discrete_inputs: 0}\n", ":5:33: unknown device 'e'"},
                         Case{dev + "    - {image: \"%IX0.0\", device: d}\n", ":5:7: name one table"},
-                        Case{dev + "    - {image: \"%IX0.0\", device: d, discrete_inputs: 70000}\n", "address 70000 is outside 0..65535"},
+                        Case{dev + "    - {image: \"%IX0.0\", device: d, discrete_inputs: 70000}\n", "address: 70000 is outside 0..65535"},
                         Case{dev + "    - {image: \"%IX0.0\", count: 8, device: d, discrete_inputs: 0}\n"
                                    "    - {image: \"%IX0.4\", device: d, discrete_inputs: 9}\n",
                              ":6:15: overlaps the mapping at"},
-                        Case{"io:\n  devices:\n    - {name: d, rtu: {device: /dev/ttyS0, parity: X}}\n  map: []\n", ":3:51: parity must be N, E or O"},
+                        Case{"io:\n  devices:\n    - {name: d, rtu: {device: /dev/ttyS0, parity: X}}\n  map: []\n", ":3:51: parity: expected N, E or O, got 'X'"},
                         Case{"io:\n  devices:\n    - {name: d, tcp: \"[::1:1502\"}\n  map: []\n", ":3:22: missing ']'"},
                         Case{"io:\n  devices:\n    - {name: d, tcp: \"h:1\", status: \"%QX0.0\"}\n  map: []\n", "status must be an input bit"},
                         Case{"io:\n  devices:\n    - {name: d, tcp: \"h:1\", speed: 3}\n  map: []\n", ":3:29: unknown key 'speed'"}}) {

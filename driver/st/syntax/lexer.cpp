@@ -8,6 +8,8 @@
 #include <cmath>
 #include <string>
 
+#include "common/duration.hpp"
+
 namespace plcfi::st {
 
 namespace {
@@ -529,14 +531,6 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
     }
     return ns;
   };
-  auto add_checked = [&](int64_t* acc, uint64_t count, int64_t unit) {
-    int64_t part = 0;
-    if (count > static_cast<uint64_t>(INT64_MAX) ||
-        __builtin_mul_overflow(static_cast<int64_t>(count), unit, &part) ||
-        __builtin_add_overflow(*acc, part, acc))
-      return fail(begin, "value out of range (at most about 292 years)");
-    return true;
-  };
   auto expect_char = [&](char c, const char* what) {
     if (peek() == c) {
       ++pos_;
@@ -595,59 +589,17 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
     return true;
   };
   if (kind == TimePrefix::Duration) {
-    bool negative = false;
-    if (peek() == '-' || peek() == '+') {
-      negative = peek() == '-';
-      ++pos_;
-    }
-    if (!is_digit(peek())) {
-      fail(pos_, "expected a duration such as 1h2m3s4ms after '#'");
-    } else {
-      while (ok) {
-        uint64_t count = 0;
-        size_t n = 0;
-        const size_t num_at = pos_;
-        read_uint(&count, &n);
-        const bool has_frac = peek() == '.' && is_digit(peek(1));
-        const size_t frac_at = pos_;
-        if (has_frac) {
-          ++pos_;
-          while (pos_ < text_.size() && (is_digit(text_[pos_]) || text_[pos_] == '_')) ++pos_;
-        }
-        const size_t unit_at = pos_;
-        while (pos_ < text_.size() && std::isalpha(static_cast<unsigned char>(text_[pos_]))) ++pos_;
-        const std::string unit = canon(text_.substr(unit_at, pos_ - unit_at));
-        int64_t unit_ns = 0;
-        if (unit == "D") unit_ns = kNsPerDay;
-        else if (unit == "H") unit_ns = 3600 * kNsPerSec;
-        else if (unit == "M") unit_ns = 60 * kNsPerSec;
-        else if (unit == "S") unit_ns = kNsPerSec;
-        else if (unit == "MS") unit_ns = 1'000'000;
-        else if (unit == "US") unit_ns = 1'000;
-        else if (unit == "NS") unit_ns = 1;
-        if (unit.empty()) {
-          fail(unit_at, "missing duration unit after '" + std::string(text_.substr(num_at, unit_at - num_at)) +
-                            "' (use d, h, m, s, ms, us or ns)");
-          break;
-        }
-        if (unit_ns == 0) {
-          fail(unit_at, "unknown duration unit '" + std::string(text_.substr(unit_at, pos_ - unit_at)) +
-                            "' (use d, h, m, s, ms, us or ns)");
-          break;
-        }
-        if (!add_checked(&value, count, unit_ns)) break;
-        if (has_frac) {
-          const size_t save = pos_;
-          pos_ = frac_at + 1;
-          const int64_t frac = read_fraction(unit_ns);
-          pos_ = save;
-          if (!add_checked(&value, 1, frac)) break;
-        }
-        if (peek() == '_' && is_digit(peek(1))) ++pos_;
-        if (!is_digit(peek())) break;
-      }
-    }
-    if (negative) value = -value;
+    // The literal's extent: a sign, then letters, digits, '_' and '.' (a TIME has no
+    // subranges, so no '..' can follow); its value is the shared parser's, so T#8.2ms here
+    // and "8.2ms" in a spec file are the same nanoseconds, and a malformed literal is one
+    // token with the parser's message.
+    size_t end = pos_;
+    if (end < text_.size() && (text_[end] == '-' || text_[end] == '+')) ++end;
+    while (end < text_.size() && (is_ident_char(text_[end]) || text_[end] == '.')) ++end;
+    const common::DurationParse d = common::parse_duration_body(text_.substr(pos_, end - pos_));
+    if (d.ok()) value = d.ns;
+    else fail(pos_ + d.error_at, d.error);
+    pos_ = end;
     lit = LiteralKind::Time;
   } else if (kind == TimePrefix::Date) {
     int64_t days = 0;

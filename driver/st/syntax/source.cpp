@@ -2,8 +2,8 @@
 #include "source.hpp"
 
 #include <cctype>
-#include <fstream>
-#include <sstream>
+
+#include "common/file.hpp"
 
 namespace plcfi::st {
 
@@ -27,18 +27,9 @@ uint32_t SourceManager::add(std::string path, std::string text) {
 }
 
 bool SourceManager::load(const std::string& path, uint32_t* index, std::string* err) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *err = path + ": cannot open file";
-    return false;
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) {
-    *err = path + ": read error";
-    return false;
-  }
-  *index = add(path, ss.str());
+  std::string text;
+  if (!common::read_file(path, common::kMaxSourceBytes, &text, err)) return false;
+  *index = add(path, std::move(text));
   return true;
 }
 

@@ -194,7 +194,7 @@ TEST(EdtlErrors, FormulaErrorsPointIntoTheRequirementsFile) {
   auto notrig = write_temp("plcfi_edtl_notrig.yaml", "requirements:\n  - id: R\n    reaction: \"b\"\n");
   RequirementsFile r2;
   EXPECT_FALSE(load_requirements(notrig, &r2, &err));
-  EXPECT_NE(std::string::npos, err.find("has no trigger")) << err;
+  EXPECT_NE(std::string::npos, err.find("plcfi_edtl_notrig.yaml:2:5: missing key 'trigger' in requirement 'R'")) << err;
 }
 
 // ---------------------------------------------------------------- property test

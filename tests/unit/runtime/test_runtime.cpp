@@ -318,7 +318,11 @@ TEST(Runtime, DurationsParseLikeIecLiterals) {
   EXPECT_FALSE(parse_duration("10 parsecs", &ns, &err));
   EXPECT_FALSE(parse_duration("", &ns, &err));
   EXPECT_FALSE(parse_duration("5x", &ns, &err));
-  EXPECT_NE(std::string::npos, err.find("unknown unit"));
+  EXPECT_EQ(err, "'5x' is not a duration: unknown duration unit 'x' (use d, h, m, s, ms, us or ns)");
+  // Exact decimal arithmetic (no double): 8.2 ms is 8,200,000 ns, not 8,199,999.
+  ASSERT_TRUE(parse_duration("8.2ms", &ns, &err));
+  EXPECT_EQ(8'200'000, ns);
+  EXPECT_FALSE(parse_duration("1.2.3ms", &ns, &err));
 }
 
 TEST(LatencyStats, PercentilesFromTheHistogram) {
