@@ -1,0 +1,325 @@
+// plcfi_oracle: differential testing of the ST engine (interpreter and native tier) against
+// the reference evaluator, on random programs from the generator or on given files.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "engine.hpp"
+#include "generator.hpp"
+#include "native/native.hpp"
+#include "reference.hpp"
+#include "syntax/parser.hpp"
+
+namespace plcfi::oracle {
+namespace {
+
+struct Options {
+  uint64_t seed = 1;
+  uint64_t count = 100;
+  int scans = 5;
+  uint64_t native_every = 0;  // 0: never; n: every n-th program also runs natively
+  std::string out = "oracle-out";
+  std::vector<std::string> files;
+  GenOptions gen;
+  bool shrink = true;
+  bool verbose = false;
+};
+
+enum class Kind { Match, Mismatch, CompileError, Unsupported, RefTrap, EngineTrap, NativeError };
+const char* kind_name(Kind k) {
+  switch (k) {
+    case Kind::Match: return "match";
+    case Kind::Mismatch: return "MISMATCH";
+    case Kind::CompileError: return "engine compile error";
+    case Kind::Unsupported: return "outside the evaluator's subset";
+    case Kind::RefTrap: return "reference trapped";
+    case Kind::EngineTrap: return "engine trapped";
+    case Kind::NativeError: return "native build failed";
+  }
+  return "?";
+}
+
+struct Outcome {
+  Kind kind = Kind::Match;
+  std::string detail;
+};
+
+// Equal values: integers by their bits, reals by value (so -0.0 equals 0.0, which MIN and
+// MAX may return either of), NaN equal to NaN, strings by their text.
+bool same(const st::Machine& m, const st::VarHandle& h, const Value& v, std::string* engine_text) {
+  *engine_text = st::format(m, h);
+  switch (v.t->kind) {
+    case VK::Bool: return st::read_bool(m, h) == (v.i != 0);
+    case VK::Int:
+    case VK::Time: {
+      uint64_t mask = v.t->bits == 64 || v.t->kind == VK::Time ? ~uint64_t{0} : (uint64_t{1} << v.t->bits) - 1;
+      return (static_cast<uint64_t>(st::read_int(m, h)) & mask) == (static_cast<uint64_t>(v.i) & mask);
+    }
+    case VK::Real:
+    case VK::LReal: {
+      double x = st::read_real(m, h);
+      return x == v.r || (x != x && v.r != v.r);
+    }
+    case VK::String: return *engine_text == "'" + v.s + "'";
+    default: return true;
+  }
+}
+
+// Compiles and runs one program in the interpreter (and natively when asked) and in the
+// reference evaluator, comparing every variable after every scan.
+Outcome check(const std::string& name, const std::string& text, int scans, bool native) {
+  st::CompileOptions copt;
+  copt.warnings = false;
+  auto b = st::build_sources({{name, text}}, copt);
+  if (!b->ok()) return {Kind::CompileError, b->diags.render_all()};
+  const st::Application& app = *b->app;
+
+  st::SourceManager sm;
+  st::DiagEngine diags(sm);
+  auto unit = st::parse_unit(sm, sm.add(name, text), diags);
+  std::unique_ptr<Reference> ref;
+  try {
+    ref = std::make_unique<Reference>(std::vector<const st::CompilationUnit*>{unit.get()});
+  } catch (const Unsupported& e) {
+    return {Kind::Unsupported, e.what()};
+  } catch (const RefTrap& e) {
+    return {Kind::RefTrap, std::string("initial values: ") + e.what()};
+  }
+
+  std::unique_ptr<st::NativeCode> code;
+  if (native) {
+    std::string err;
+    code = st::NativeCode::build(app, st::NativeOptions{}, &err);
+    if (!code) return {Kind::NativeError, err};
+  }
+  Outcome result;
+  {
+    st::Machine interp(app);
+    std::optional<st::Machine> nat;
+    interp.set_budget(10'000'000);
+    if (code) {
+      nat.emplace(app);
+      nat->set_budget(10'000'000);
+      nat->set_native(code.get());
+    }
+    std::map<std::string, st::VarHandle> handles;
+    for (int s = 0; s < scans && result.kind == Kind::Match; ++s) {
+      std::vector<st::Machine*> machines{&interp};
+      if (nat) machines.push_back(&*nat);
+      for (st::Machine* m : machines) {
+        m->set_now(s * 10'000'000LL);
+        for (const auto& inst : app.programs)
+          if (!m->call(inst.pou->entry, inst.addr)) {
+            result = {Kind::EngineTrap, "scan " + std::to_string(s + 1) + (m == &interp ? " (interpreter): " : " (native): ") +
+                                            st::describe_trap(app, m->trap())};
+            break;
+          }
+      }
+      if (result.kind != Kind::Match) break;
+      try {
+        ref->scan();
+      } catch (const RefTrap& e) {
+        result = {Kind::RefTrap, "scan " + std::to_string(s + 1) + ": " + e.what()};
+        break;
+      } catch (const Unsupported& e) {
+        result = {Kind::Unsupported, e.what()};
+        break;
+      }
+      for (const Leaf& leaf : ref->leaves()) {
+        auto it = handles.find(leaf.path);
+        if (it == handles.end()) {
+          std::string err;
+          auto h = st::resolve(app, leaf.path, &err);
+          if (!h) {
+            result = {Kind::Unsupported, "the engine does not resolve " + leaf.path + ": " + err};
+            break;
+          }
+          it = handles.emplace(leaf.path, *h).first;
+        }
+        std::string ti, tn;
+        bool ok_i = same(interp, it->second, leaf.v, &ti);
+        bool ok_n = !nat || same(*nat, it->second, leaf.v, &tn);
+        if (!ok_i || !ok_n) {
+          std::string d = "after scan " + std::to_string(s + 1) + ": " + leaf.path + " = " + Reference::text(leaf.v) +
+                          " in the reference, " + ti + " in the interpreter";
+          if (nat) d += ", " + tn + " in the native tier";
+          result = {Kind::Mismatch, d};
+          break;
+        }
+      }
+    }
+  }
+  if (code) {
+    std::error_code ec;
+    std::filesystem::remove(code->library(), ec);  // long runs would fill the cache otherwise
+  }
+  return result;
+}
+
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::string join(const std::vector<std::string>& lines) {
+  std::string t;
+  for (const auto& l : lines) t += l + "\n";
+  return t;
+}
+
+// Deletes statement lines (every line ending in ';': statements, and declarations whose
+// removal the compiler then accepts or rejects) while the program still mismatches.
+std::string shrink(const std::string& text, int scans, bool native, std::string* detail) {
+  std::vector<std::string> lines = split_lines(text);
+  int tries = 0;
+  const int max_tries = native ? 150 : 3000;
+  for (bool changed = true; changed && tries < max_tries;) {
+    changed = false;
+    for (size_t i = lines.size(); i-- > 0 && tries < max_tries;) {
+      const std::string& l = lines[i];
+      if (l.empty() || l.back() != ';' || l.rfind("END_", 0) == 0) continue;
+      std::vector<std::string> cand = lines;
+      cand.erase(cand.begin() + static_cast<long>(i));
+      ++tries;
+      Outcome o = check("shrink.st", join(cand), scans, native);
+      if (o.kind == Kind::Mismatch) {
+        lines = std::move(cand);
+        *detail = o.detail;
+        changed = true;
+      }
+    }
+  }
+  return join(lines);
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  std::ofstream f(path);
+  f << text;
+}
+
+int usage() {
+  std::fprintf(stderr,
+               "usage: plcfi_oracle [--seed S] [--count N] [--scans K] [--native | --no-native]\n"
+               "                    [--native-every M] [--out DIR] [--avoid method-args-with-calls]\n"
+               "                    [--no-shrink] [--verbose] [FILE.st ...]\n"
+               "Generates N programs from seeds S, S+1, ... (or takes the given files), runs K scans of each\n"
+               "in the interpreter (and the native tier: --native every program, --native-every M every M-th)\n"
+               "and in the reference evaluator, and compares every variable after every scan.\n");
+  return 2;
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "plcfi_oracle: %s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    try {
+      if (a == "--seed") o.seed = std::stoull(next());
+      else if (a == "--count") o.count = std::stoull(next());
+      else if (a == "--scans") o.scans = std::stoi(next());
+      else if (a == "--native") o.native_every = 1;
+      else if (a == "--no-native") o.native_every = 0;
+      else if (a == "--native-every") o.native_every = std::stoull(next());
+      else if (a == "--out") o.out = next();
+      else if (a == "--no-shrink") o.shrink = false;
+      else if (a == "--verbose") o.verbose = true;
+      else if (a == "--avoid") {
+        std::string what = next();
+        if (what != "method-args-with-calls") {
+          std::fprintf(stderr, "plcfi_oracle: --avoid knows only method-args-with-calls, not '%s'\n", what.c_str());
+          return 2;
+        }
+        o.gen.avoid_method_args_with_calls = true;
+      } else if (a == "--help" || a == "-h") {
+        usage();
+        return 0;
+      } else if (!a.empty() && a[0] == '-') {
+        std::fprintf(stderr, "plcfi_oracle: unknown option '%s'\n", a.c_str());
+        return usage();
+      } else {
+        o.files.push_back(a);
+      }
+    } catch (const std::exception&) {
+      std::fprintf(stderr, "plcfi_oracle: bad value for %s\n", a.c_str());
+      return 2;
+    }
+  }
+  std::filesystem::create_directories(o.out);
+  std::map<Kind, uint64_t> counts;
+  uint64_t natives = 0;
+  auto t0 = std::chrono::steady_clock::now();
+  auto report = [&](const std::string& label, const std::string& text, bool native, const Outcome& r) {
+    ++counts[r.kind];
+    if (r.kind == Kind::Match) {
+      if (o.verbose) std::printf("%s: match%s\n", label.c_str(), native ? " (with the native tier)" : "");
+      return;
+    }
+    std::string file = o.out + "/" + label + ".st";
+    write_file(file, text);
+    std::printf("%s: %s%s\n  %s\n  program: %s\n", label.c_str(), kind_name(r.kind), native ? " (native tier on)" : "",
+                r.detail.c_str(), file.c_str());
+    if (r.kind == Kind::Mismatch && o.shrink) {
+      std::string detail = r.detail;
+      std::string small = shrink(text, o.scans, native, &detail);
+      std::string min_file = o.out + "/" + label + ".min.st";
+      write_file(min_file, small);
+      std::printf("  shrunk to %zu lines: %s\n  %s\n", split_lines(small).size(), min_file.c_str(), detail.c_str());
+    }
+    std::fflush(stdout);
+  };
+  if (!o.files.empty()) {
+    for (size_t k = 0; k < o.files.size(); ++k) {
+      std::ifstream f(o.files[k]);
+      if (!f) {
+        std::fprintf(stderr, "plcfi_oracle: %s: cannot open\n", o.files[k].c_str());
+        return 2;
+      }
+      std::stringstream ss;
+      ss << f.rdbuf();
+      bool native = o.native_every != 0;
+      natives += native;
+      Outcome r = check(o.files[k], ss.str(), o.scans, native);
+      report(std::filesystem::path(o.files[k]).stem().string(), ss.str(), native, r);
+      if (r.kind == Kind::Match) std::printf("%s: match\n", o.files[k].c_str());
+    }
+  } else {
+    for (uint64_t k = 0; k < o.count; ++k) {
+      uint64_t seed = o.seed + k;
+      std::string text = generate_program(seed, o.gen);
+      bool native = o.native_every != 0 && k % o.native_every == 0;
+      natives += native;
+      Outcome r = check("seed-" + std::to_string(seed) + ".st", text, o.scans, native);
+      report("seed-" + std::to_string(seed), text, native, r);
+    }
+  }
+  double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  uint64_t total = 0;
+  for (const auto& [k, n] : counts) total += n;
+  std::printf("%llu program(s), %llu with the native tier, %d scan(s) each, %.1f s (%.1f programs/s):",
+              static_cast<unsigned long long>(total), static_cast<unsigned long long>(natives), o.scans, secs,
+              secs > 0 ? static_cast<double>(total) / secs : 0.0);
+  for (const auto& [k, n] : counts) std::printf(" %llu %s,", static_cast<unsigned long long>(n), kind_name(k));
+  std::printf("\n");
+  return counts[Kind::Match] == total ? 0 : 1;
+}
+
+}  // namespace
+}  // namespace plcfi::oracle
+
+int main(int argc, char** argv) { return plcfi::oracle::run(argc, argv); }
