@@ -29,7 +29,7 @@ struct Options {
   std::string out = "oracle-out";
   std::vector<std::string> files;
   GenOptions gen;
-  bool shrink = true;
+  uint64_t shrink_first = 1;  // failures shrunk (each costs up to thousands of runs)
   bool verbose = false;
 };
 
@@ -177,26 +177,56 @@ std::string join(const std::vector<std::string>& lines) {
   return t;
 }
 
-// Deletes statement lines (every line ending in ';': statements, and declarations whose
-// removal the compiler then accepts or rejects) while the program still mismatches.
-std::string shrink(const std::string& text, int scans, bool native, std::string* detail) {
+// What a shrunk program must keep: the same kind of failure, and for a trap the same
+// message (a deleted assignment must not turn one trap into another).
+bool same_failure(const Outcome& a, const Outcome& b) {
+  if (a.kind != b.kind) return false;
+  if (a.kind != Kind::EngineTrap) return true;
+  auto msg = [](const std::string& d) {
+    auto at = d.find("runtime error");
+    return at == std::string::npos ? d : d.substr(at);
+  };
+  return msg(a.detail) == msg(b.detail);
+}
+
+// Deletes what it can while the failure stays: whole POUs, methods and properties, then
+// statement lines (every statement is on a line of its own; declarations end in ';' too,
+// and the compiler rejects a program that still needs one), until nothing more goes.
+std::string shrink(const std::string& text, int scans, bool native, Outcome* failure) {
   std::vector<std::string> lines = split_lines(text);
   int tries = 0;
-  const int max_tries = native ? 150 : 3000;
+  const int max_tries = native ? 120 : 4000;
+  auto attempt = [&](size_t from, size_t to) {  // deletes lines [from, to)
+    if (tries >= max_tries) return false;
+    std::vector<std::string> cand = lines;
+    cand.erase(cand.begin() + static_cast<long>(from), cand.begin() + static_cast<long>(to));
+    ++tries;
+    Outcome o = check("shrink.st", join(cand), scans, native);
+    if (!same_failure(o, *failure)) return false;
+    lines = std::move(cand);
+    *failure = o;
+    return true;
+  };
+  static const char* kBlocks[][2] = {{"FUNCTION_BLOCK ", "END_FUNCTION_BLOCK"}, {"FUNCTION ", "END_FUNCTION"},
+                                     {"METHOD ", "END_METHOD"},                 {"PROPERTY ", "END_PROPERTY"},
+                                     {"VAR", "END_VAR"},                        {"SET", "END_SET"},
+                                     {"GET", "END_GET"}};
   for (bool changed = true; changed && tries < max_tries;) {
     changed = false;
-    for (size_t i = lines.size(); i-- > 0 && tries < max_tries;) {
+    for (const auto& b : kBlocks) {
+      for (size_t i = lines.size(); i-- > 0;) {
+        if (i >= lines.size() || lines[i].rfind(b[0], 0) != 0) continue;
+        if (std::string(b[0]) == "VAR" && lines[i].find(' ') != std::string::npos) continue;
+        size_t j = i + 1;
+        while (j < lines.size() && lines[j] != b[1] && lines[j].rfind(std::string(b[1]) + " ", 0) != 0) ++j;
+        if (j < lines.size() && attempt(i, j + 1)) changed = true;
+      }
+    }
+    for (size_t i = lines.size(); i-- > 0;) {
+      if (i >= lines.size()) continue;
       const std::string& l = lines[i];
       if (l.empty() || l.back() != ';' || l.rfind("END_", 0) == 0) continue;
-      std::vector<std::string> cand = lines;
-      cand.erase(cand.begin() + static_cast<long>(i));
-      ++tries;
-      Outcome o = check("shrink.st", join(cand), scans, native);
-      if (o.kind == Kind::Mismatch) {
-        lines = std::move(cand);
-        *detail = o.detail;
-        changed = true;
-      }
+      if (attempt(i, i + 1)) changed = true;
     }
   }
   return join(lines);
@@ -211,10 +241,11 @@ int usage() {
   std::fprintf(stderr,
                "usage: plcfi_oracle [--seed S] [--count N] [--scans K] [--native | --no-native]\n"
                "                    [--native-every M] [--out DIR] [--avoid method-args-with-calls]\n"
-               "                    [--no-shrink] [--verbose] [FILE.st ...]\n"
+               "                    [--shrink-first N | --no-shrink] [--verbose] [FILE.st ...]\n"
                "Generates N programs from seeds S, S+1, ... (or takes the given files), runs K scans of each\n"
                "in the interpreter (and the native tier: --native every program, --native-every M every M-th)\n"
-               "and in the reference evaluator, and compares every variable after every scan.\n");
+               "and in the reference evaluator, and compares every variable after every scan. Failing programs\n"
+               "are written to DIR; the first N failures (default 1) are also shrunk to DIR/<name>.min.st.\n");
   return 2;
 }
 
@@ -237,7 +268,8 @@ int run(int argc, char** argv) {
       else if (a == "--no-native") o.native_every = 0;
       else if (a == "--native-every") o.native_every = std::stoull(next());
       else if (a == "--out") o.out = next();
-      else if (a == "--no-shrink") o.shrink = false;
+      else if (a == "--no-shrink") o.shrink_first = 0;
+      else if (a == "--shrink-first") o.shrink_first = std::stoull(next());
       else if (a == "--verbose") o.verbose = true;
       else if (a == "--avoid") {
         std::string what = next();
@@ -262,7 +294,7 @@ int run(int argc, char** argv) {
   }
   std::filesystem::create_directories(o.out);
   std::map<Kind, uint64_t> counts;
-  uint64_t natives = 0;
+  uint64_t natives = 0, shrunk = 0;
   auto t0 = std::chrono::steady_clock::now();
   auto report = [&](const std::string& label, const std::string& text, bool native, const Outcome& r) {
     ++counts[r.kind];
@@ -274,12 +306,15 @@ int run(int argc, char** argv) {
     write_file(file, text);
     std::printf("%s: %s%s\n  %s\n  program: %s\n", label.c_str(), kind_name(r.kind), native ? " (native tier on)" : "",
                 r.detail.c_str(), file.c_str());
-    if (r.kind == Kind::Mismatch && o.shrink) {
-      std::string detail = r.detail;
-      std::string small = shrink(text, o.scans, native, &detail);
+    if ((r.kind == Kind::Mismatch || r.kind == Kind::EngineTrap) && shrunk < o.shrink_first) {
+      ++shrunk;
+      Outcome failure = r;
+      // A failure the interpreter shows alone shrinks without a native build per attempt.
+      bool shrink_native = native && !same_failure(check(label + ".st", text, o.scans, false), r);
+      std::string small = shrink(text, o.scans, shrink_native, &failure);
       std::string min_file = o.out + "/" + label + ".min.st";
       write_file(min_file, small);
-      std::printf("  shrunk to %zu lines: %s\n  %s\n", split_lines(small).size(), min_file.c_str(), detail.c_str());
+      std::printf("  shrunk to %zu lines: %s\n  %s\n", split_lines(small).size(), min_file.c_str(), failure.detail.c_str());
     }
     std::fflush(stdout);
   };
