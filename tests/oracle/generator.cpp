@@ -94,6 +94,8 @@ struct FbInfo {
   std::vector<Callable> props;     // with a setter
   std::vector<std::pair<std::string, T>> step_params;
   bool has_calc = false;
+  bool derived = false;  // EXTENDS another FB and has no body: never called as an FB
+  std::vector<std::pair<std::string, T>> state;
 };
 
 class Gen {
@@ -124,6 +126,7 @@ class Gen {
   std::string pou_vars(const std::string& section, const std::vector<std::pair<std::string, T>>& v);
   void function(int k);
   void fb(int k, bool implements);
+  void derived_fb(int k, const FbInfo& base);
 
   std::mt19937_64 rng_;
   GenOptions opt_;
@@ -414,6 +417,7 @@ std::string Gen::stmt(const Scope& s, int depth) {
     const auto& [inst, k] = fb_insts_[pick(static_cast<int>(fb_insts_.size()))];
     const FbInfo& f = fbs_[k];
     int q = pick(3);
+    if (q == 0 && f.derived) q = 1;
     if (q == 0) {
       // Whether an FB call's inputs are stored one by one as they are evaluated, or all
       // evaluated first, is the implementation's choice (plcfi stores them one by one): the
@@ -449,7 +453,10 @@ std::string Gen::stmt(const Scope& s, int depth) {
     if (is_real(p.ret)) rhs = "LIMIT(-" + std::string(name(p.ret)) + "#1000000.0, " + rhs + ", " + name(p.ret) + "#1000000.0)";
     return inst + "." + p.prefix + " := " + rhs + ";";
   }
-  if (s.fb_statements && r < 50) return "IF " + expr(T::Bool, s, 2) + " THEN itf := ia; ELSE itf := ib; END_IF;";
+  if (s.fb_statements && r < 50) {
+    const char* kTargets[] = {"ia", "ib", "id"};
+    return "IF " + expr(T::Bool, s, 2) + " THEN itf := " + kTargets[pick(3)] + "; ELSE itf := ib; END_IF;";
+  }
   if (w.empty()) return ";";
   return assign(*w[pick(static_cast<int>(w.size()))], s, ed);
 }
@@ -586,6 +593,54 @@ void Gen::fb(int k, bool implements) {
     loop_vars_.clear();
   }
   f.methods = own;
+  f.state = state;
+  fbs_.push_back(f);
+}
+
+// An FB that EXTENDS `base`, overriding Calc and M0 (which call SUPER^ and never a method
+// that could come back to them: the inherited M1 may call THIS^.M0, now the override).
+void Gen::derived_fb(int k, const FbInfo& base) {
+  FbInfo f = base;
+  f.type = "Fb" + std::to_string(k);
+  f.derived = true;
+  std::vector<std::pair<std::string, T>> own{{"x0", any_scalar()}, {"x1", any_scalar()}};
+  out_ << "FUNCTION_BLOCK " << f.type << " EXTENDS " << base.type << "\nVAR\n";
+  for (const auto& [n, t] : own) out_ << "  " << n << " : " << type_text(t) << " := " << literal(t) << ";\n";
+  out_ << "END_VAR\n";
+  Scope s;
+  for (const auto& v : base.inputs) s.places.push_back(Place{v.first, "", v.second, false});
+  for (const auto& v : base.outputs) s.places.push_back(Place{"THIS^." + v.first, "", v.second, false});
+  for (const auto& v : base.state) s.places.push_back(Place{v.first, "", v.second, false});
+  for (const auto& v : own) s.places.push_back(Place{chance(50) ? v.first : "THIS^." + v.first, "", v.second, false});
+  s.calls = functions_;
+  for (auto c : base.props) {
+    c.prefix = "THIS^." + c.prefix;
+    s.calls.push_back(c);
+  }
+  auto override_method = [&](const Callable& m, bool may_call_calc) {
+    Scope ms = s;
+    Callable sup = m;
+    sup.prefix = "SUPER^." + m.prefix;
+    ms.calls.push_back(sup);
+    if (may_call_calc) {
+      Callable calc;
+      calc.prefix = "THIS^.Calc";
+      calc.ret = T::Dint;
+      calc.params = {{"k", T::Dint}};
+      calc.is_method = true;
+      ms.calls.push_back(calc);
+    }
+    for (const auto& [pn, pt] : m.params) ms.places.push_back(Place{pn, "", pt, false});
+    out_ << "METHOD " << m.prefix << " : " << type_text(m.ret) << "\n" << pou_vars("VAR_INPUT", m.params);
+    out_ << "VAR\n  mv : " << type_text(m.ret) << " := " << literal(m.ret) << ";\nEND_VAR\n";
+    ms.places.push_back(Place{"mv", "", m.ret, true});
+    out_ << stmt(ms, 1) << "\n" << assign(Place{m.prefix, "", m.ret, true}, ms, 3) << "\nEND_METHOD\n";
+  };
+  for (const auto& m : base.methods) {
+    if (m.prefix == "Calc") override_method(m, false);
+    if (m.prefix == "M0") override_method(m, true);
+  }
+  out_ << "END_FUNCTION_BLOCK\n\n";
   fbs_.push_back(f);
 }
 
@@ -607,6 +662,7 @@ std::string Gen::program() {
   fb(0, true);
   fb(1, true);
   fb(2, false);
+  derived_fb(3, fbs_[0]);
 
   Scope s;
   s.fb_statements = true;
@@ -634,8 +690,9 @@ std::string Gen::program() {
     s.places.push_back(Place{"rs", "." + n, t, true, true, 1, 3});
   }
   for (const auto& [n, t] : globals) s.places.push_back(Place{n, "", t, true});
-  // Instances: ia and ib implement IGen, ic is a third type, ia2 a second instance of Fb0.
-  const std::pair<std::string, int> insts[] = {{"ia", 0}, {"ib", 1}, {"ic", 2}, {"ia2", 0}};
+  // Instances: ia and ib implement IGen, ic is a third type, ia2 a second instance of Fb0,
+  // id of Fb3 EXTENDS Fb0 (so it implements IGen too).
+  const std::pair<std::string, int> insts[] = {{"ia", 0}, {"ib", 1}, {"ic", 2}, {"ia2", 0}, {"id", 3}};
   for (const auto& [inst, k] : insts) {
     out_ << "  " << inst << " : " << fbs_[static_cast<size_t>(k)].type << ";\n";
     fb_insts_.emplace_back(inst, k);

@@ -58,6 +58,7 @@ Value* Vars::find(const std::string& canon_name) {
 struct Reference::Env {
   Vars* locals = nullptr;
   Instance* self = nullptr;
+  const st::Pou* owner = nullptr;  // the FB declaring the running body or method (for SUPER)
 };
 
 Reference::Reference(const std::vector<const st::CompilationUnit*>& units) {
@@ -216,12 +217,21 @@ void Reference::declare(Vars& vars, const std::vector<st::VarBlock>& blocks, Env
   }
 }
 
+const st::Pou* Reference::base_of(const st::Pou* fb) const {
+  if (!fb->extends) return nullptr;
+  auto it = pous_.find(canon(fb->extends->text));
+  if (it == pous_.end() || it->second->kind != st::PouKind::FunctionBlock) throw Unsupported("EXTENDS of a non-FB");
+  return it->second;
+}
+
 std::shared_ptr<Instance> Reference::instantiate(const st::Pou* pou) {
-  if (pou->extends) throw Unsupported("EXTENDS");
   auto inst = std::make_shared<Instance>();
   inst->pou = pou;
+  // Inherited variables first, from the root of the chain down.
+  std::vector<const st::Pou*> chain;
+  for (const st::Pou* p = pou; p; p = base_of(p)) chain.insert(chain.begin(), p);
   Env env;
-  declare(inst->vars, pou->var_blocks, &env);
+  for (const st::Pou* p : chain) declare(inst->vars, p->var_blocks, &env);
   return inst;
 }
 
@@ -231,6 +241,7 @@ void Reference::scan() {
     Vars temps;
     env.locals = &temps;
     env.self = inst.get();
+    env.owner = inst->pou;
     exec(inst->pou->body, env);
   }
 }
@@ -255,10 +266,11 @@ Reference::Flow Reference::exec(const st::Stmt& s, Env& env) {
       if (a.lhs->kind == st::ExprKind::Member) {
         const auto& m = static_cast<const st::MemberExpr&>(*a.lhs);
         if (Instance* inst = as_instance(*m.base, env)) {
-          if (const auto* p = find_property(inst->pou, canon(m.member.text))) {
+          const st::Pou* owner = nullptr;
+          if (const auto* p = find_property(inst->pou, canon(m.member.text), &owner)) {
             if (!p->setter) throw Unsupported("property without setter");
             Value v = eval(*a.rhs, env);
-            run_pou(*p->setter, inst, nullptr, env, p->name.text, p->type.get(), &v);
+            run_pou(*p->setter, inst, owner, nullptr, env, p->name.text, p->type.get(), &v);
             return Flow::Normal;
           }
         }
@@ -354,8 +366,9 @@ Reference::Flow Reference::exec(const st::Stmt& s, Env& env) {
 // ---------------------------------------------------------------- places
 
 Instance* Reference::as_instance(const st::Expr& e, Env& env) {
-  if (e.kind == st::ExprKind::This) return env.self;
-  if (e.kind == st::ExprKind::Deref && static_cast<const st::DerefExpr&>(e).base->kind == st::ExprKind::This)
+  if (e.kind == st::ExprKind::This || e.kind == st::ExprKind::Super) return env.self;
+  if (e.kind == st::ExprKind::Deref && (static_cast<const st::DerefExpr&>(e).base->kind == st::ExprKind::This ||
+                                        static_cast<const st::DerefExpr&>(e).base->kind == st::ExprKind::Super))
     return env.self;
   if (e.kind != st::ExprKind::Name && e.kind != st::ExprKind::Member && e.kind != st::ExprKind::Index) return nullptr;
   if (e.kind == st::ExprKind::Name) {
@@ -367,7 +380,7 @@ Instance* Reference::as_instance(const st::Expr& e, Env& env) {
   if (e.kind == st::ExprKind::Member) {
     const auto& m = static_cast<const st::MemberExpr&>(e);
     Instance* base = as_instance(*m.base, env);
-    if (base && find_property(base->pou, canon(m.member.text))) return nullptr;
+    if (base && find_property(base->pou, canon(m.member.text), nullptr)) return nullptr;
   }
   Value* v = lvalue(e, env);
   if (v->t->kind == VK::Fb) return v->fb.get();
@@ -515,9 +528,10 @@ Value Reference::eval(const st::Expr& e, Env& env) {
     case st::ExprKind::Member: {
       const auto& m = static_cast<const st::MemberExpr&>(e);
       if (Instance* inst = as_instance(*m.base, env)) {
-        if (const auto* p = find_property(inst->pou, canon(m.member.text))) {
+        const st::Pou* owner = nullptr;
+        if (const auto* p = find_property(inst->pou, canon(m.member.text), &owner)) {
           if (!p->getter) throw Unsupported("property without getter");
-          return run_pou(*p->getter, inst, nullptr, env, p->name.text, p->type.get(), nullptr);
+          return run_pou(*p->getter, inst, owner, nullptr, env, p->name.text, p->type.get(), nullptr);
         }
       }
       return *lvalue(e, env);
@@ -734,19 +748,29 @@ Value Reference::no_value() const {
   return v;
 }
 
-const st::Pou* Reference::find_method(const st::Pou* fb, const std::string& c) const {
-  for (const auto& m : fb->methods)
-    if (canon(m->name.text) == c) return m.get();
+// Methods are virtual: the search starts at the instance's own type and goes up the
+// EXTENDS chain; *owner receives the FB that declares the method found.
+const st::Pou* Reference::find_method(const st::Pou* fb, const std::string& c, const st::Pou** owner) const {
+  for (const st::Pou* p = fb; p; p = base_of(p))
+    for (const auto& m : p->methods)
+      if (canon(m->name.text) == c) {
+        if (owner) *owner = p;
+        return m.get();
+      }
   return nullptr;
 }
 
-const st::PropertyDecl* Reference::find_property(const st::Pou* fb, const std::string& c) const {
-  for (const auto& p : fb->properties)
-    if (canon(p->name.text) == c) return p.get();
+const st::PropertyDecl* Reference::find_property(const st::Pou* fb, const std::string& c, const st::Pou** owner) const {
+  for (const st::Pou* p = fb; p; p = base_of(p))
+    for (const auto& q : p->properties)
+      if (canon(q->name.text) == c) {
+        if (owner) *owner = p;
+        return q.get();
+      }
   return nullptr;
 }
 
-Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::CallExpr* c, Env& caller,
+Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owner, const st::CallExpr* c, Env& caller,
                          const std::string& result_name, const st::TypeSpec* result_type, const Value* setter_value) {
   // Arguments are evaluated in the caller's frame first, left to right, then bound.
   std::vector<std::pair<std::string, Value>> inputs;
@@ -769,6 +793,7 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::CallExpr*
   Env env;
   env.locals = &frame;
   env.self = self;
+  env.owner = owner;
   declare(frame, pou.var_blocks, &env);  // every call starts from the declared initial values
   if (result_type) frame.add(result_name, make(type_of(*result_type)));
   if (setter_value) assign(*frame.find(canon(result_name)), *setter_value);
@@ -787,12 +812,20 @@ Value Reference::call(const st::CallExpr& c, Env& env) {
     const auto& m = static_cast<const st::MemberExpr&>(*c.callee);
     Instance* inst = as_instance(*m.base, env);
     if (!inst) throw Unsupported("method call on a non-instance");
-    const st::Pou* method = find_method(inst->pou, canon(m.member.text));
+    // SUPER^.M() is bound statically: the search starts above the running method's FB.
+    const st::Expr* b = m.base.get();
+    if (b->kind == st::ExprKind::Deref) b = static_cast<const st::DerefExpr*>(b)->base.get();
+    const st::Pou* start = inst->pou;
+    if (b->kind == st::ExprKind::Super) {
+      if (!env.owner || !(start = base_of(env.owner))) throw Unsupported("SUPER without a base");
+    }
+    const st::Pou* owner = nullptr;
+    const st::Pou* method = find_method(start, canon(m.member.text), &owner);
     if (!method) {
       // A nested FB instance called as a.b(...) is not generated.
       throw Unsupported("unknown method " + m.member.text);
     }
-    return run_pou(*method, inst, &c, env, method->name.text, method->return_type.get(), nullptr);
+    return run_pou(*method, inst, owner, &c, env, method->name.text, method->return_type.get(), nullptr);
   }
   if (c.callee->kind != st::ExprKind::Name) throw Unsupported("callee kind");
   std::string name = canon(static_cast<const st::NameExpr&>(*c.callee).name.text);
@@ -800,7 +833,7 @@ Value Reference::call(const st::CallExpr& c, Env& env) {
   Value v = standard(name, c, env, &found);
   if (found) return v;
   if (auto p = pous_.find(name); p != pous_.end() && p->second->kind == st::PouKind::Function)
-    return run_pou(*p->second, nullptr, &c, env, p->second->name.text, p->second->return_type.get(), nullptr);
+    return run_pou(*p->second, nullptr, nullptr, &c, env, p->second->name.text, p->second->return_type.get(), nullptr);
   // An FB instance: inputs in, body, outputs out.
   Instance* inst = as_instance(*c.callee, env);
   if (!inst) throw Unsupported("unknown function " + name);
@@ -818,6 +851,8 @@ Value Reference::call(const st::CallExpr& c, Env& env) {
   Env fb_env;
   fb_env.locals = &temps;
   fb_env.self = inst;
+  fb_env.owner = inst->pou;
+  // A derived FB's call runs its own body only (the generator calls no derived FB).
   exec(inst->pou->body, fb_env);
   for (const auto& a : c.args) {
     if (!a.is_output || !a.value) continue;

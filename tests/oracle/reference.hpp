@@ -104,10 +104,11 @@ class Reference {
   Value call(const st::CallExpr& c, Env& env);
   Value standard(const std::string& name, const st::CallExpr& c, Env& env, bool* found);
   Value convert(const Value& v, const RType* to);
-  Value run_pou(const st::Pou& pou, Instance* self, const st::CallExpr* c, Env& caller,
+  Value run_pou(const st::Pou& pou, Instance* self, const st::Pou* owner, const st::CallExpr* c, Env& caller,
                 const std::string& result_name, const st::TypeSpec* result_type, const Value* setter_value);
-  const st::Pou* find_method(const st::Pou* fb, const std::string& canon_name) const;
-  const st::PropertyDecl* find_property(const st::Pou* fb, const std::string& canon_name) const;
+  const st::Pou* base_of(const st::Pou* fb) const;
+  const st::Pou* find_method(const st::Pou* fb, const std::string& canon_name, const st::Pou** owner) const;
+  const st::PropertyDecl* find_property(const st::Pou* fb, const std::string& canon_name, const st::Pou** owner) const;
   Value no_value() const;
   void collect(const std::string& path, const Value& v, std::vector<Leaf>& out) const;
 
