@@ -203,8 +203,12 @@ std::string Gen::leaf(T t, const Scope& s) {
 }
 
 std::string Gen::call_text(const Callable& c, const Scope& s, int depth) {
-  if (c.is_property) return c.prefix;
-  std::string text = c.prefix + "(";
+  std::string callee = c.prefix;
+  // `fbs[?].M0`: a method of an element of an array of instances, index computed here.
+  if (auto at = callee.find("[?]"); at != std::string::npos)
+    callee.replace(at, 3, "[LIMIT(DINT#1, " + expr(T::Dint, s, depth - 1) + ", DINT#2)]");
+  if (c.is_property) return callee;
+  std::string text = callee + "(";
   bool named = c.is_method || chance(60);
   for (size_t i = 0; i < c.params.size(); ++i) {
     if (i) text += ", ";
@@ -398,8 +402,9 @@ std::string Gen::stmt(const Scope& s, int depth) {
       by = " BY (-DINT#1)";
     }
     auto bound = [](int b) { return b < 0 ? "(-DINT#" + std::to_string(-b) + ")" : "DINT#" + std::to_string(b); };
-    std::string t = "FOR " + v + " := " + bound(from) + " TO " + bound(to) + by + " DO " +
-                    stmts(inner, 1 + pick(2), depth - 1);
+    std::string t = "FOR " + v + " := " + bound(from) + " TO " + bound(to) + by + " DO ";
+    if (chance(20)) t += "IF " + expr(T::Bool, inner, 2) + " THEN CONTINUE; END_IF; ";
+    t += stmts(inner, 1 + pick(2), depth - 1);
     if (chance(25)) t += " IF " + expr(T::Bool, inner, 2) + " THEN EXIT; END_IF;";
     return t + " END_FOR;";
   }
@@ -414,10 +419,12 @@ std::string Gen::stmt(const Scope& s, int depth) {
            " >= DINT#" + std::to_string(n) + " END_REPEAT;";
   }
   if (s.fb_statements && r < 45 && !fb_insts_.empty()) {
-    const auto& [inst, k] = fb_insts_[pick(static_cast<int>(fb_insts_.size()))];
-    const FbInfo& f = fbs_[k];
+    auto [inst, k] = fb_insts_[pick(static_cast<int>(fb_insts_.size()))];
+    const FbInfo& f = fbs_[static_cast<size_t>(k)];
     int q = pick(3);
-    if (q == 0 && f.derived) q = 1;
+    bool element = inst.find("[?]") != std::string::npos;
+    if (q == 0 && (f.derived || element)) q = 1;
+    if (element) inst.replace(inst.find("[?]"), 3, "[LIMIT(DINT#1, " + expr(T::Dint, s, 1) + ", DINT#2)]");
     if (q == 0) {
       // Whether an FB call's inputs are stored one by one as they are evaluated, or all
       // evaluated first, is the implementation's choice (plcfi stores them one by one): the
@@ -453,7 +460,12 @@ std::string Gen::stmt(const Scope& s, int depth) {
     if (is_real(p.ret)) rhs = "LIMIT(-" + std::string(name(p.ret)) + "#1000000.0, " + rhs + ", " + name(p.ret) + "#1000000.0)";
     return inst + "." + p.prefix + " := " + rhs + ";";
   }
-  if (s.fb_statements && r < 50) {
+  if (s.fb_statements && r < 53) {
+    // Whole structures copied in both directions.
+    std::string i = "rs[LIMIT(DINT#1, " + expr(T::Dint, s, 1) + ", DINT#3)]";
+    return chance(50) ? "r1 := " + i + ";" : i + " := r1;";
+  }
+  if (s.fb_statements && r < 56) {
     const char* kTargets[] = {"ia", "ib", "id"};
     return "IF " + expr(T::Bool, s, 2) + " THEN itf := " + kTargets[pick(3)] + "; ELSE itf := ib; END_IF;";
   }
@@ -487,6 +499,8 @@ void Gen::function(int k) {
   for (const auto& [ln, lt] : locals) out_ << "  " << ln << " : " << type_text(lt) << " := " << literal(lt) << ";\n";
   out_ << "END_VAR\n";
   for (int i = 0; i < 2; ++i) out_ << stmt(s, 1) << "\n";
+  if (chance(40))
+    out_ << "IF " << expr(T::Bool, s, 2) << " THEN " << assign(Place{c.prefix, "", c.ret, true}, s, 2) << " RETURN; END_IF;\n";
   out_ << assign(Place{c.prefix, "", c.ret, true}, s, 3) << "\nEND_FUNCTION\n\n";
   functions_.push_back(c);
 }
@@ -532,7 +546,10 @@ void Gen::fb(int k, bool implements) {
     out_ << "METHOD " << mname << " : " << type_text(ret) << "\n" << pou_vars("VAR_INPUT", params);
     out_ << "VAR\n  mv : " << type_text(ret) << " := " << literal(ret) << ";\nEND_VAR\n";
     s.places.push_back(Place{"mv", "", ret, true});
-    out_ << stmt(s, 1) << "\n" << assign(Place{mname, "", ret, true}, s, 3) << "\nEND_METHOD\n";
+    out_ << stmt(s, 1) << "\n";
+    if (chance(40))
+      out_ << "IF " << expr(T::Bool, s, 2) << " THEN " << assign(Place{mname, "", ret, true}, s, 2) << " RETURN; END_IF;\n";
+    out_ << assign(Place{mname, "", ret, true}, s, 3) << "\nEND_METHOD\n";
     Callable c;
     c.prefix = mname;
     c.ret = ret;
@@ -675,6 +692,7 @@ std::string Gen::program() {
     if (chance(40)) out_ << " := " << literal(t);
     out_ << ";\n";
     s.places.push_back(Place{n, "", t, true});
+    if (is_bits(t)) s.places.push_back(Place{n + "." + std::to_string(pick(width(t))), "", T::Bool, true});  // one bit
   }
   for (int i = 0; i < 2; ++i) {
     T t = any_scalar();
@@ -709,6 +727,18 @@ std::string Gen::program() {
   }
   // The interface refers to an instance before any statement can call through it.
   std::string first = "IF " + expr(T::Bool, s, 2) + " THEN itf := ia; ELSE itf := ib; END_IF;\n";
+  // An array of instances of Fb2: methods, properties and outputs of an indexed element.
+  out_ << "  fbs : ARRAY[1..2] OF " << fbs_[2].type << ";\n";
+  fb_insts_.emplace_back("fbs[?]", 2);
+  for (const auto& [o, t] : fbs_[2].outputs) s.places.push_back(Place{"fbs", "." + o, t, false, true, 1, 2});
+  for (auto c : fbs_[2].methods) {
+    c.prefix = "fbs[?]." + c.prefix;
+    s.calls.push_back(c);
+  }
+  for (auto c : fbs_[2].props) {
+    c.prefix = "fbs[?]." + c.prefix;
+    s.calls.push_back(c);
+  }
   Callable calc;
   calc.prefix = "itf.Calc";
   calc.ret = T::Dint;

@@ -242,6 +242,7 @@ int usage() {
                "usage: plcfi_oracle [--seed S] [--count N] [--scans K] [--native | --no-native]\n"
                "                    [--native-every M] [--out DIR] [--avoid method-args-with-calls]\n"
                "                    [--shrink-first N | --no-shrink] [--verbose] [FILE.st ...]\n"
+               "       plcfi_oracle --seed S [--avoid ...] --emit     (prints the program of seed S)\n"
                "Generates N programs from seeds S, S+1, ... (or takes the given files), runs K scans of each\n"
                "in the interpreter (and the native tier: --native every program, --native-every M every M-th)\n"
                "and in the reference evaluator, and compares every variable after every scan. Failing programs\n"
@@ -271,6 +272,10 @@ int run(int argc, char** argv) {
       else if (a == "--no-shrink") o.shrink_first = 0;
       else if (a == "--shrink-first") o.shrink_first = std::stoull(next());
       else if (a == "--verbose") o.verbose = true;
+      else if (a == "--emit") {  // prints the program of --seed and stops
+        std::fputs(generate_program(o.seed, o.gen).c_str(), stdout);
+        return 0;
+      }
       else if (a == "--avoid") {
         std::string what = next();
         if (what != "method-args-with-calls") {

@@ -276,7 +276,7 @@ Reference::Flow Reference::exec(const st::Stmt& s, Env& env) {
         }
       }
       Value v = eval(*a.rhs, env);
-      assign(*lvalue(*a.lhs, env), v);
+      store(*a.lhs, v, env);
       return Flow::Normal;
     }
     case st::StmtKind::Call:
@@ -432,6 +432,20 @@ Value* Reference::lvalue(const st::Expr& e, Env& env) {
   }
 }
 
+void Reference::store(const st::Expr& place, const Value& v, Env& env) {
+  if (place.kind == st::ExprKind::BitAccess) {  // w.3 := b sets one bit of w
+    const auto& b = static_cast<const st::BitAccessExpr&>(place);
+    Value* w = lvalue(*b.base, env);
+    if (w->t->kind != VK::Int || v.t->kind != VK::Bool || static_cast<int>(b.bit) >= w->t->bits)
+      throw Unsupported("bit assignment");
+    uint64_t mask = uint64_t{1} << b.bit;
+    uint64_t bits = static_cast<uint64_t>(w->i);
+    w->i = norm(w->t, v.i ? (bits | mask) : (bits & ~mask));
+    return;
+  }
+  assign(*lvalue(place, env), v);
+}
+
 void Reference::assign(Value& dst, const Value& src) {
   switch (dst.t->kind) {
     case VK::Bool:
@@ -538,6 +552,15 @@ Value Reference::eval(const st::Expr& e, Env& env) {
     }
     case st::ExprKind::Index:
       return *lvalue(e, env);
+    case st::ExprKind::BitAccess: {
+      const auto& b = static_cast<const st::BitAccessExpr&>(e);
+      Value w = eval(*b.base, env);
+      if (w.t->kind != VK::Int || static_cast<int>(b.bit) >= w.t->bits) throw Unsupported("bit access");
+      Value v;
+      v.t = elementary("BOOL");
+      v.i = (static_cast<uint64_t>(w.i) >> b.bit) & 1;
+      return v;
+    }
     case st::ExprKind::Call:
       return call(static_cast<const st::CallExpr&>(e), env);
     case st::ExprKind::Unary: {
@@ -858,7 +881,7 @@ Value Reference::call(const st::CallExpr& c, Env& env) {
     if (!a.is_output || !a.value) continue;
     if (a.negate) throw Unsupported("negated output");
     Value out = *inst->vars.find(canon(a.name->text));
-    assign(*lvalue(*a.value, env), out);
+    store(*a.value, out, env);
   }
   return no_value();
 }

@@ -99,6 +99,7 @@ class Reference {
   Value* lvalue(const st::Expr& e, Env& env);
   Instance* as_instance(const st::Expr& e, Env& env);
   void assign(Value& dst, const Value& src);
+  void store(const st::Expr& place, const Value& v, Env& env);  // assignment to a place or a bit
   Value binary(st::BinaryOp op, const Value& a, const Value& b);
   Value unary(st::UnaryOp op, const Value& a);
   Value call(const st::CallExpr& c, Env& env);
