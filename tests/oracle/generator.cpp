@@ -79,6 +79,7 @@ struct Callable {
   std::vector<std::pair<std::string, T>> params;  // empty and is_property: `fa.P0`
   bool is_method = false;
   bool is_property = false;
+  bool itf_param = false;  // the first parameter is an IGen: an instance or itf is passed
 };
 
 struct Scope {
@@ -93,6 +94,7 @@ struct FbInfo {
   std::vector<Callable> methods;   // pure: callable in expressions (prefix without the instance)
   std::vector<Callable> props;     // with a setter
   std::vector<std::pair<std::string, T>> step_params;
+  T step_output = T::Dint;  // Step's VAR_OUTPUT q
   bool has_calc = false;
   bool derived = false;  // EXTENDS another FB and has no body: never called as an FB
   std::vector<std::pair<std::string, T>> state;
@@ -213,6 +215,11 @@ std::string Gen::call_text(const Callable& c, const Scope& s, int depth) {
   for (size_t i = 0; i < c.params.size(); ++i) {
     if (i) text += ", ";
     if (named) text += c.params[i].first + " := ";
+    if (i == 0 && c.itf_param) {
+      static const char* kItf[] = {"ia", "ib", "id", "itf"};
+      text += kItf[pick(4)];
+      continue;
+    }
     bool plain = c.is_method && opt_.avoid_method_args_with_calls;
     text += plain ? leaf(c.params[i].second, s) : expr(c.params[i].second, s, depth - 1);
   }
@@ -453,6 +460,10 @@ std::string Gen::stmt(const Scope& s, int depth) {
       for (size_t i = 0; i < f.step_params.size(); ++i)
         t += (i ? ", " : "") + f.step_params[i].first + " := " +
              (opt_.avoid_method_args_with_calls ? leaf(f.step_params[i].second, s) : expr(f.step_params[i].second, s, ed));
+      std::vector<const Place*> dst;
+      for (const auto* p : w)
+        if (p->t == f.step_output && !p->indexed) dst.push_back(p);
+      if (!dst.empty() && chance(60)) t += ", q => " + dst[pick(static_cast<int>(dst.size()))]->base;
       return t + ");";
     }
     const Callable& p = f.props[pick(static_cast<int>(f.props.size()))];
@@ -601,9 +612,12 @@ void Gen::fb(int k, bool implements) {
     loop_vars_ = {loop};
     Scope step = s;
     step.places.push_back(Place{"d", "", f.step_params[0].second, false});
+    f.step_output = any_scalar();
     // A FOR control variable must be local to the method.
-    out_ << "METHOD Step\n" << pou_vars("VAR_INPUT", f.step_params) << "VAR\n  " << loop << " : DINT;\nEND_VAR\n";
-    out_ << stmts(step, 2, 2, "\n") << "\ncnt := cnt + DINT#1;\nEND_METHOD\n";
+    out_ << "METHOD Step\n" << pou_vars("VAR_INPUT", f.step_params) << pou_vars("VAR_OUTPUT", {{"q", f.step_output}})
+         << "VAR\n  " << loop << " : DINT;\nEND_VAR\n";
+    out_ << stmts(step, 2, 2, "\n") << "\n" << assign(Place{"q", "", f.step_output, true}, step, 2)
+         << "\ncnt := cnt + DINT#1;\nEND_METHOD\n";
     // The body.
     loop_vars_.clear();
     out_ << stmts(s, 3, 2, "\n") << "\nEND_FUNCTION_BLOCK\n\n";
@@ -676,6 +690,8 @@ std::string Gen::program() {
 
   int nf = 2 + pick(3);
   for (int i = 0; i < nf; ++i) function(i);
+  // A FUNCTION taking an interface: dispatch through a parameter.
+  out_ << "FUNCTION FI : DINT\nVAR_INPUT\n  i : IGen;\n  k : DINT;\nEND_VAR\nFI := i.Calc(k := k) - k;\nEND_FUNCTION\n\n";
   fb(0, true);
   fb(1, true);
   fb(2, false);
@@ -739,6 +755,11 @@ std::string Gen::program() {
     c.prefix = "fbs[?]." + c.prefix;
     s.calls.push_back(c);
   }
+  Callable fi;
+  fi.prefix = "FI";
+  fi.params = {{"i", T::Dint}, {"k", T::Dint}};  // i: the interface, written by call_text
+  fi.itf_param = true;
+  s.calls.push_back(fi);
   Callable calc;
   calc.prefix = "itf.Calc";
   calc.ret = T::Dint;

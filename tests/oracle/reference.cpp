@@ -805,7 +805,8 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owne
   if (c) {
     size_t pos = 0;
     for (const auto& a : c->args) {
-      if (a.is_output || a.negate) throw Unsupported("output argument of a function or method");
+      if (a.negate) throw Unsupported("negated output argument");
+      if (a.is_output) continue;  // stored after the call
       std::string name = a.name ? canon(a.name->text) : (pos < input_order.size() ? input_order[pos] : "");
       if (name.empty()) throw Unsupported("too many positional arguments");
       ++pos;
@@ -826,6 +827,14 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owne
     assign(*dst, v);
   }
   exec(pou.body, env);
+  if (c)
+    for (const auto& a : c->args)
+      if (a.is_output && a.value) {
+        Value* out = frame.find(canon(a.name->text));
+        if (!out) throw Unsupported("unknown output " + a.name->text);
+        Value copy = *out;
+        store(*a.value, copy, caller);
+      }
   if (!result_type || setter_value) return no_value();
   return *frame.find(canon(result_name));
 }
