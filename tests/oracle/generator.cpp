@@ -85,7 +85,8 @@ struct Callable {
 struct Scope {
   std::vector<Place> places;
   std::vector<Callable> calls;
-  bool fb_statements = false;  // FB instances and globals may be changed (Main)
+  std::vector<std::pair<std::string, int>> insts;  // FB instances statements may call, and their FB index
+  bool fb_statements = false;  // Main: the interface may be reassigned, structures copied
 };
 
 struct FbInfo {
@@ -127,7 +128,7 @@ class Gen {
   std::string assign(const Place& p, const Scope& s, int depth);
   std::string pou_vars(const std::string& section, const std::vector<std::pair<std::string, T>>& v);
   void function(int k);
-  void fb(int k, bool implements);
+  void fb(int k, bool implements, int inner);
   void derived_fb(int k, const FbInfo& base);
 
   std::mt19937_64 rng_;
@@ -139,7 +140,6 @@ class Gen {
   int loops_ = 0;
   std::vector<std::string> loop_vars_;   // FOR control variables not in use by an outer loop
   std::vector<std::string> while_vars_;  // WHILE/REPEAT counters not in use
-  std::vector<std::pair<std::string, int>> fb_insts_;  // Main's instances and their FB index
 };
 
 std::string Gen::literal(T t) {
@@ -425,8 +425,8 @@ std::string Gen::stmt(const Scope& s, int depth) {
     return v + " := DINT#0; REPEAT " + stmts(s, 1 + pick(2), depth - 1) + " " + v + " := " + v + " + DINT#1; UNTIL " + v +
            " >= DINT#" + std::to_string(n) + " END_REPEAT;";
   }
-  if (s.fb_statements && r < 45 && !fb_insts_.empty()) {
-    auto [inst, k] = fb_insts_[pick(static_cast<int>(fb_insts_.size()))];
+  if (r < 45 && !s.insts.empty()) {
+    auto [inst, k] = s.insts[static_cast<size_t>(pick(static_cast<int>(s.insts.size())))];
     const FbInfo& f = fbs_[static_cast<size_t>(k)];
     int q = pick(3);
     bool element = inst.find("[?]") != std::string::npos;
@@ -516,7 +516,9 @@ void Gen::function(int k) {
   functions_.push_back(c);
 }
 
-void Gen::fb(int k, bool implements) {
+// inner >= 0: the FB holds an instance `inner` of FB number `inner`, which its methods read
+// and its body and Step change.
+void Gen::fb(int k, bool implements, int inner) {
   FbInfo f;
   f.type = "Fb" + std::to_string(k);
   for (int i = 0; i < 2; ++i) f.inputs.emplace_back("in" + std::to_string(i), any_scalar());
@@ -527,20 +529,36 @@ void Gen::fb(int k, bool implements) {
   std::vector<std::pair<std::string, T>> props;
   for (int i = 0; i < 2; ++i) props.emplace_back("P" + std::to_string(i), state[static_cast<size_t>(pick(4))].second);
 
+  out_ << "FUNCTION_BLOCK " << f.type << (implements ? " IMPLEMENTS IGen" : "") << "\n";
+  out_ << pou_vars("VAR_INPUT", f.inputs) << pou_vars("VAR_OUTPUT", f.outputs);
+  out_ << "VAR\n";
+  for (const auto& [n, t] : state) out_ << "  " << n << " : " << type_text(t) << " := " << literal(t) << ";\n";
+  std::vector<Callable> inner_calls;  // pure methods and getters of the inner instance
+  std::vector<Place> inner_places;
+  if (inner >= 0) {
+    const FbInfo& in = fbs_[static_cast<size_t>(inner)];
+    out_ << "  inner : " << in.type << ";\n";
+    for (auto c : in.methods) {
+      c.prefix = "inner." + c.prefix;
+      inner_calls.push_back(c);
+    }
+    for (auto c : in.props) {
+      c.prefix = "inner." + c.prefix;
+      inner_calls.push_back(c);
+    }
+    for (const auto& [o, t] : in.outputs) inner_places.push_back(Place{"inner." + o, "", t, false});
+  }
+  std::string loop = "loop" + std::to_string(loops_++);
+  out_ << "END_VAR\n";
   // Instance variables, read as `x` or `THIS^.x`.
   auto instance_places = [&](bool writable) {
-    std::vector<Place> ps;
+    std::vector<Place> ps = inner_places;
     for (const auto& v : f.inputs) ps.push_back(Place{chance(50) ? v.first : "THIS^." + v.first, "", v.second, false});
     for (const auto& v : f.outputs) ps.push_back(Place{v.first, "", v.second, writable});
     for (const auto& v : state) ps.push_back(Place{chance(50) ? v.first : "THIS^." + v.first, "", v.second, writable});
     return ps;
   };
-  out_ << "FUNCTION_BLOCK " << f.type << (implements ? " IMPLEMENTS IGen" : "") << "\n";
-  out_ << pou_vars("VAR_INPUT", f.inputs) << pou_vars("VAR_OUTPUT", f.outputs);
-  out_ << "VAR\n";
-  for (const auto& [n, t] : state) out_ << "  " << n << " : " << type_text(t) << " := " << literal(t) << ";\n";
-  std::string loop = "loop" + std::to_string(loops_++);
-  out_ << "END_VAR\n";
+
 
   // Pure methods: they read the instance and write only their own variables, so that a
   // call inside an expression has no effect that an evaluation order could expose.
@@ -549,6 +567,7 @@ void Gen::fb(int k, bool implements) {
     Scope s;
     s.places = instance_places(false);
     s.calls = functions_;
+    s.calls.insert(s.calls.end(), inner_calls.begin(), inner_calls.end());
     for (auto c : own) {
       c.prefix = "THIS^." + c.prefix;
       s.calls.push_back(c);
@@ -601,6 +620,8 @@ void Gen::fb(int k, bool implements) {
     Scope s;
     s.places = instance_places(true);
     s.calls = functions_;
+    s.calls.insert(s.calls.end(), inner_calls.begin(), inner_calls.end());
+    if (inner >= 0) s.insts.emplace_back("inner", inner);
     for (auto c : own) {
       c.prefix = "THIS^." + c.prefix;
       s.calls.push_back(c);
@@ -692,10 +713,10 @@ std::string Gen::program() {
   for (int i = 0; i < nf; ++i) function(i);
   // A FUNCTION taking an interface: dispatch through a parameter.
   out_ << "FUNCTION FI : DINT\nVAR_INPUT\n  i : IGen;\n  k : DINT;\nEND_VAR\nFI := i.Calc(k := k) - k;\nEND_FUNCTION\n\n";
-  fb(0, true);
-  fb(1, true);
-  fb(2, false);
-  derived_fb(3, fbs_[0]);
+  fb(0, false, -1);
+  fb(1, true, 0);
+  fb(2, true, -1);
+  derived_fb(3, fbs_[1]);
 
   Scope s;
   s.fb_statements = true;
@@ -724,12 +745,12 @@ std::string Gen::program() {
     s.places.push_back(Place{"rs", "." + n, t, true, true, 1, 3});
   }
   for (const auto& [n, t] : globals) s.places.push_back(Place{n, "", t, true});
-  // Instances: ia and ib implement IGen, ic is a third type, ia2 a second instance of Fb0,
-  // id of Fb3 EXTENDS Fb0 (so it implements IGen too).
-  const std::pair<std::string, int> insts[] = {{"ia", 0}, {"ib", 1}, {"ic", 2}, {"ia2", 0}, {"id", 3}};
+  // Instances: ia (Fb1, holding an Fb0) and ib (Fb2) implement IGen, ic is an Fb0, ia2 a
+  // second Fb1, id an Fb3 EXTENDS Fb1 (so it implements IGen too).
+  const std::pair<std::string, int> insts[] = {{"ia", 1}, {"ib", 2}, {"ic", 0}, {"ia2", 1}, {"id", 3}};
   for (const auto& [inst, k] : insts) {
     out_ << "  " << inst << " : " << fbs_[static_cast<size_t>(k)].type << ";\n";
-    fb_insts_.emplace_back(inst, k);
+    s.insts.emplace_back(inst, k);
     const FbInfo& f = fbs_[static_cast<size_t>(k)];
     for (const auto& [o, t] : f.outputs) s.places.push_back(Place{inst + "." + o, "", t, false});
     for (auto c : f.methods) {
@@ -743,15 +764,15 @@ std::string Gen::program() {
   }
   // The interface refers to an instance before any statement can call through it.
   std::string first = "IF " + expr(T::Bool, s, 2) + " THEN itf := ia; ELSE itf := ib; END_IF;\n";
-  // An array of instances of Fb2: methods, properties and outputs of an indexed element.
-  out_ << "  fbs : ARRAY[1..2] OF " << fbs_[2].type << ";\n";
-  fb_insts_.emplace_back("fbs[?]", 2);
-  for (const auto& [o, t] : fbs_[2].outputs) s.places.push_back(Place{"fbs", "." + o, t, false, true, 1, 2});
-  for (auto c : fbs_[2].methods) {
+  // An array of instances of Fb0: methods, properties and outputs of an indexed element.
+  out_ << "  fbs : ARRAY[1..2] OF " << fbs_[0].type << ";\n";
+  s.insts.emplace_back("fbs[?]", 0);
+  for (const auto& [o, t] : fbs_[0].outputs) s.places.push_back(Place{"fbs", "." + o, t, false, true, 1, 2});
+  for (auto c : fbs_[0].methods) {
     c.prefix = "fbs[?]." + c.prefix;
     s.calls.push_back(c);
   }
-  for (auto c : fbs_[2].props) {
+  for (auto c : fbs_[0].props) {
     c.prefix = "fbs[?]." + c.prefix;
     s.calls.push_back(c);
   }
