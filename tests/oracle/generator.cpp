@@ -138,6 +138,7 @@ class Gen {
   std::vector<FbInfo> fbs_;
   int str_len_ = 12;
   int loops_ = 0;
+  std::vector<std::pair<std::string, T>> globals_;  // read everywhere, written by FB bodies, Step and Main
   std::vector<std::string> loop_vars_;   // FOR control variables not in use by an outer loop
   std::vector<std::string> while_vars_;  // WHILE/REPEAT counters not in use
 };
@@ -500,6 +501,7 @@ void Gen::function(int k) {
   Scope s;
   s.calls = functions_;
   for (const auto& [pn, pt] : c.params) s.places.push_back(Place{pn, "", pt, false});
+  for (const auto& [gn, gt] : globals_) s.places.push_back(Place{gn, "", gt, false});
   std::vector<std::pair<std::string, T>> locals;
   for (int i = 0; i < 2; ++i) {
     locals.emplace_back("t" + std::to_string(i), any_scalar());
@@ -553,6 +555,7 @@ void Gen::fb(int k, bool implements, int inner) {
   // Instance variables, read as `x` or `THIS^.x`.
   auto instance_places = [&](bool writable) {
     std::vector<Place> ps = inner_places;
+    for (const auto& [gn, gt] : globals_) ps.push_back(Place{gn, "", gt, writable});
     for (const auto& v : f.inputs) ps.push_back(Place{chance(50) ? v.first : "THIS^." + v.first, "", v.second, false});
     for (const auto& v : f.outputs) ps.push_back(Place{v.first, "", v.second, writable});
     for (const auto& v : state) ps.push_back(Place{chance(50) ? v.first : "THIS^." + v.first, "", v.second, writable});
@@ -705,9 +708,8 @@ std::string Gen::program() {
   for (const auto& [n, t] : fields) out_ << "  " << n << " : " << type_text(t) << ";\n";
   out_ << "END_STRUCT;\nEND_TYPE\n\n";
   out_ << "INTERFACE IGen\nMETHOD Calc : DINT\nVAR_INPUT\n  k : DINT;\nEND_VAR\nEND_METHOD\nEND_INTERFACE\n\n";
-  std::vector<std::pair<std::string, T>> globals;
-  for (int i = 0; i < 2; ++i) globals.emplace_back("g" + std::to_string(i), any_scalar());
-  out_ << pou_vars("VAR_GLOBAL", globals) << "\n";
+  for (int i = 0; i < 2; ++i) globals_.emplace_back("g" + std::to_string(i), any_scalar());
+  out_ << pou_vars("VAR_GLOBAL", globals_) << "\n";
 
   int nf = 2 + pick(3);
   for (int i = 0; i < nf; ++i) function(i);
@@ -744,7 +746,7 @@ std::string Gen::program() {
     s.places.push_back(Place{"r1." + n, "", t, true});
     s.places.push_back(Place{"rs", "." + n, t, true, true, 1, 3});
   }
-  for (const auto& [n, t] : globals) s.places.push_back(Place{n, "", t, true});
+  for (const auto& [n, t] : globals_) s.places.push_back(Place{n, "", t, true});
   // Instances: ia (Fb1, holding an Fb0) and ib (Fb2) implement IGen, ic is an Fb0, ia2 a
   // second Fb1, id an Fb3 EXTENDS Fb1 (so it implements IGen too).
   const std::pair<std::string, int> insts[] = {{"ia", 1}, {"ib", 2}, {"ic", 0}, {"ia2", 1}, {"id", 3}};
