@@ -438,7 +438,12 @@ std::string Gen::stmt(const Scope& s, int depth) {
       // evaluated first, is the implementation's choice (plcfi stores them one by one): the
       // arguments must not read the instance being called.
       Scope args = s;
-      std::erase_if(args.calls, [&](const Callable& c) { return c.prefix.rfind(inst + ".", 0) == 0; });
+      // Calls that may read it: its own methods, and indirectly THIS^ methods (which read
+      // an inner instance), interface calls and FUNCTIONs taking the interface.
+      std::erase_if(args.calls, [&](const Callable& c) {
+        return c.prefix.rfind(inst + ".", 0) == 0 || c.prefix.rfind("THIS^.", 0) == 0 || c.prefix.rfind("itf.", 0) == 0 ||
+               c.itf_param;
+      });
       std::string t = inst + "(";
       bool first = true;
       for (const auto& [n, ty] : f.inputs) {
