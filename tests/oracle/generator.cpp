@@ -69,6 +69,7 @@ struct Place {
   bool writable = true;
   bool indexed = false;
   int lo = 0, hi = 0;
+  bool bit = false;  // `w.3`: no address (VAR_IN_OUT) can be taken
 };
 
 // Something callable that yields a value: a FUNCTION, a method, a property getter, an
@@ -138,6 +139,7 @@ class Gen {
   std::vector<FbInfo> fbs_;
   int str_len_ = 12;
   int loops_ = 0;
+  T fio_type_ = T::Dint;                          // FIO's parameters and result
   std::vector<std::pair<std::string, T>> globals_;  // read everywhere, written by FB bodies, Step and Main
   std::vector<std::string> loop_vars_;   // FOR control variables not in use by an outer loop
   std::vector<std::string> while_vars_;  // WHILE/REPEAT counters not in use
@@ -477,6 +479,16 @@ std::string Gen::stmt(const Scope& s, int depth) {
     if (is_real(p.ret)) rhs = "LIMIT(-" + std::string(name(p.ret)) + "#1000000.0, " + rhs + ", " + name(p.ret) + "#1000000.0)";
     return inst + "." + p.prefix + " := " + rhs + ";";
   }
+  if (s.fb_statements && r < 51) {
+    std::vector<const Place*> io;
+    for (const auto* p : w)
+      if (p->t == fio_type_ && !p->bit) io.push_back(p);
+    if (io.size() >= 2) {
+      const Place* dst = io[static_cast<size_t>(pick(static_cast<int>(io.size())))];
+      const Place* ref = io[static_cast<size_t>(pick(static_cast<int>(io.size())))];
+      return place_text(*dst, s, 1) + " := FIO(io := " + place_text(*ref, s, 1) + ", a := " + expr(fio_type_, s, ed) + ");";
+    }
+  }
   if (s.fb_statements && r < 53) {
     // Whole structures copied in both directions.
     std::string i = "rs[LIMIT(DINT#1, " + expr(T::Dint, s, 1) + ", DINT#3)]";
@@ -718,6 +730,17 @@ std::string Gen::program() {
 
   int nf = 2 + pick(3);
   for (int i = 0; i < nf; ++i) function(i);
+  // A FUNCTION with a VAR_IN_OUT, which it changes: called only as a statement's right side.
+  {
+    fio_type_ = any_scalar();
+    std::string tt = type_text(fio_type_);
+    out_ << "FUNCTION FIO : " << tt << "\nVAR_IN_OUT\n  io : " << tt << ";\nEND_VAR\nVAR_INPUT\n  a : " << tt
+         << ";\nEND_VAR\n";
+    Scope fs;
+    fs.calls = functions_;
+    fs.places = {Place{"io", "", fio_type_, true}, Place{"a", "", fio_type_, false}};
+    out_ << stmts(fs, 2, 1, "\n") << "\n" << assign(Place{"FIO", "", fio_type_, true}, fs, 2) << "\nEND_FUNCTION\n\n";
+  }
   // A FUNCTION taking an interface: dispatch through a parameter.
   out_ << "FUNCTION FI : DINT\nVAR_INPUT\n  i : IGen;\n  k : DINT;\nEND_VAR\nFI := i.Calc(k := k) - k;\nEND_FUNCTION\n\n";
   fb(0, false, -1);
@@ -736,7 +759,10 @@ std::string Gen::program() {
     if (chance(40)) out_ << " := " << literal(t);
     out_ << ";\n";
     s.places.push_back(Place{n, "", t, true});
-    if (is_bits(t)) s.places.push_back(Place{n + "." + std::to_string(pick(width(t))), "", T::Bool, true});  // one bit
+    if (is_bits(t)) {
+      s.places.push_back(Place{n + "." + std::to_string(pick(width(t))), "", T::Bool, true});  // one bit
+      s.places.back().bit = true;
+    }
   }
   for (int i = 0; i < 2; ++i) {
     T t = any_scalar();

@@ -50,6 +50,7 @@ Value& Vars::add(const std::string& name, Value v) {
 }
 
 Value* Vars::find(const std::string& canon_name) {
+  if (auto a = aliases.find(canon_name); a != aliases.end()) return a->second;
   auto it = by_name.find(canon_name);
   return it == by_name.end() ? nullptr : &it->second;
 }
@@ -797,11 +798,15 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owne
                          const std::string& result_name, const st::TypeSpec* result_type, const Value* setter_value) {
   // Arguments are evaluated in the caller's frame first, left to right, then bound.
   std::vector<std::pair<std::string, Value>> inputs;
+  std::vector<std::pair<std::string, Value*>> in_outs;
   std::vector<std::string> input_order;
+  std::map<std::string, bool> is_in_out;
   for (const auto& b : pou.var_blocks)
-    if (b.section == st::VarSection::Input)
-      for (const auto& d : b.decls)
-        for (const auto& n : d.names) input_order.push_back(canon(n.text));
+    for (const auto& d : b.decls)
+      for (const auto& n : d.names) {
+        if (b.section == st::VarSection::Input || b.section == st::VarSection::InOut) input_order.push_back(canon(n.text));
+        if (b.section == st::VarSection::InOut) is_in_out[canon(n.text)] = true;
+      }
   if (c) {
     size_t pos = 0;
     for (const auto& a : c->args) {
@@ -810,7 +815,8 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owne
       std::string name = a.name ? canon(a.name->text) : (pos < input_order.size() ? input_order[pos] : "");
       if (name.empty()) throw Unsupported("too many positional arguments");
       ++pos;
-      inputs.emplace_back(name, eval(*a.value, caller));
+      if (is_in_out.count(name)) in_outs.emplace_back(name, lvalue(*a.value, caller));
+      else inputs.emplace_back(name, eval(*a.value, caller));
     }
   }
   Vars frame;
@@ -826,6 +832,7 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owne
     if (!dst) throw Unsupported("unknown input " + name);
     assign(*dst, v);
   }
+  for (auto& [name, place] : in_outs) frame.aliases[name] = place;
   exec(pou.body, env);
   if (c)
     for (const auto& a : c->args)

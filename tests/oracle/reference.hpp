@@ -55,6 +55,7 @@ struct Value {
 // declaration order and spelling kept for paths.
 struct Vars {
   std::map<std::string, Value> by_name;
+  std::map<std::string, Value*> aliases;  // VAR_IN_OUT parameters: the caller's variable
   std::vector<std::string> order;
   Value& add(const std::string& name, Value v);
   Value* find(const std::string& canon_name);
