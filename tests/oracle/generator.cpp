@@ -837,11 +837,47 @@ std::string Gen::program() {
   return out_.str();
 }
 
+// IEC names and keywords are case-insensitive: some identifiers and keywords are written in
+// another case (never inside string literals, comments or numbers).
+std::string scramble_case(const std::string& text, uint64_t seed) {
+  std::mt19937_64 rng(seed ^ 0x5eedca5eULL);
+  std::string out = text;
+  size_t i = 0;
+  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  while (i < out.size()) {
+    char c = out[i];
+    if (c == '\'') {
+      size_t j = out.find('\'', i + 1);
+      i = j == std::string::npos ? out.size() : j + 1;
+    } else if (c == '(' && i + 1 < out.size() && out[i + 1] == '*') {
+      size_t j = out.find("*)", i + 2);
+      i = j == std::string::npos ? out.size() : j + 2;
+    } else if (std::isdigit(static_cast<unsigned char>(c))) {
+      while (i < out.size() && (ident(out[i]) || out[i] == '.')) ++i;
+    } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+      size_t j = i;
+      while (j < out.size() && ident(out[j])) ++j;
+      if (rng() % 100 < 12) {
+        int how = static_cast<int>(rng() % 3);
+        for (size_t k = i; k < j; ++k) {
+          auto u = static_cast<unsigned char>(out[k]);
+          bool up = how == 0 ? false : how == 1 ? true : (rng() & 1) != 0;
+          out[k] = static_cast<char>(up ? std::toupper(u) : std::tolower(u));
+        }
+      }
+      i = j;
+    } else {
+      ++i;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string generate_program(uint64_t seed, const GenOptions& opt) {
   Gen g(seed, opt);
-  return g.program();
+  return scramble_case(g.program(), seed);
 }
 
 }  // namespace plcfi::oracle
