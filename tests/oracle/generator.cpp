@@ -5,6 +5,7 @@
 
 #include <cctype>
 #include <functional>
+#include <map>
 #include <random>
 #include <sstream>
 #include <vector>
@@ -139,6 +140,7 @@ class Gen {
   std::vector<FbInfo> fbs_;
   int str_len_ = 12;
   int loops_ = 0;
+  std::vector<std::pair<std::string, std::vector<Place>>> refs_;  // Main's references and their targets
   T fio_type_ = T::Dint;                          // FIO's parameters and result
   std::vector<std::pair<std::string, T>> globals_;  // read everywhere, written by FB bodies, Step and Main
   std::vector<std::string> loop_vars_;   // FOR control variables not in use by an outer loop
@@ -479,6 +481,10 @@ std::string Gen::stmt(const Scope& s, int depth) {
     if (is_real(p.ret)) rhs = "LIMIT(-" + std::string(name(p.ret)) + "#1000000.0, " + rhs + ", " + name(p.ret) + "#1000000.0)";
     return inst + "." + p.prefix + " := " + rhs + ";";
   }
+  if (s.fb_statements && r < 49 && !refs_.empty()) {
+    const auto& [n, ps] = refs_[static_cast<size_t>(pick(static_cast<int>(refs_.size())))];
+    return n + " := REF(" + place_text(ps[static_cast<size_t>(pick(static_cast<int>(ps.size())))], s, 1) + ");";
+  }
   if (s.fb_statements && r < 51) {
     std::vector<const Place*> io;
     for (const auto* p : w)
@@ -797,6 +803,25 @@ std::string Gen::program() {
   }
   // The interface refers to an instance before any statement can call through it.
   std::string first = "IF " + expr(T::Bool, s, 2) + " THEN itf := ia; ELSE itf := ib; END_IF;\n";
+  // Two references, each to a type with at least two variables to point at; they point at
+  // one before any statement reads through them, and statements retarget them.
+  {
+    std::map<T, std::vector<Place>> targets;
+    for (const auto& p : s.places)
+      if (p.writable && !p.bit) targets[p.t].push_back(p);
+    std::vector<T> ok;
+    for (const auto& [t, ps] : targets)
+      if (ps.size() >= 2) ok.push_back(t);
+    for (int i = 0; i < 2 && !ok.empty(); ++i) {
+      T t = ok[static_cast<size_t>(pick(static_cast<int>(ok.size())))];
+      std::string n = "p" + std::to_string(i);
+      out_ << "  " << n << " : REF_TO " << type_text(t) << ";\n";
+      const auto& ps = targets[t];
+      first += n + " := REF(" + place_text(ps[static_cast<size_t>(pick(static_cast<int>(ps.size())))], s, 0) + ");\n";
+      refs_.emplace_back(n, ps);
+    }
+    for (const auto& [n, ps] : refs_) s.places.push_back(Place{n + "^", "", ps[0].t, true});
+  }
   // An array of instances of Fb0: methods, properties and outputs of an indexed element.
   out_ << "  fbs : ARRAY[1..2] OF " << fbs_[0].type << ";\n";
   s.insts.emplace_back("fbs[?]", 0);

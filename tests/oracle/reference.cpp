@@ -176,9 +176,24 @@ const RType* Reference::type_of(const st::TypeSpec& spec) {
       owned_.push_back(std::move(t));
       return owned_.back().get();
     }
+    case st::TypeSpecKind::Ref:
+      return ref_to(type_of(*spec.element));
     default:
       throw Unsupported("type specification kind");
   }
+}
+
+const RType* Reference::ref_to(const RType* target) {
+  auto& t = ref_types_[target];
+  if (!t) {
+    auto r = std::make_unique<RType>();
+    r->kind = VK::Ref;
+    r->name = "REF_TO " + target->name;
+    r->elem = target;
+    t = r.get();
+    owned_.push_back(std::move(r));
+  }
+  return t;
 }
 
 Value Reference::make(const RType* t) {
@@ -428,6 +443,12 @@ Value* Reference::lvalue(const st::Expr& e, Env& env) {
                       std::to_string(base->t->hi));
       return &base->elems[static_cast<size_t>(i.i - base->t->lo)];
     }
+    case st::ExprKind::Deref: {
+      Value* r = lvalue(*static_cast<const st::DerefExpr&>(e).base, env);
+      if (r->t->kind != VK::Ref) throw Unsupported("^ of a non-reference");
+      if (!r->ptr) throw RefTrap("dereference of a null reference");
+      return r->ptr;
+    }
     default:
       throw Unsupported("not a place");
   }
@@ -482,6 +503,10 @@ void Reference::assign(Value& dst, const Value& src) {
       if (src.t->kind == VK::Fb) dst.ref = src.fb.get();
       else if (src.t->kind == VK::Itf) dst.ref = src.ref;
       else throw Unsupported("interface assignment");
+      return;
+    case VK::Ref:
+      if (src.t->kind != VK::Ref || src.t->elem != dst.t->elem) throw Unsupported("reference assignment");
+      dst.ptr = src.ptr;
       return;
     case VK::Fb:
       throw Unsupported("FB instance assignment");
@@ -552,6 +577,7 @@ Value Reference::eval(const st::Expr& e, Env& env) {
       return *lvalue(e, env);
     }
     case st::ExprKind::Index:
+    case st::ExprKind::Deref:
       return *lvalue(e, env);
     case st::ExprKind::BitAccess: {
       const auto& b = static_cast<const st::BitAccessExpr&>(e);
@@ -920,6 +946,13 @@ Value Reference::standard(const std::string& name, const st::CallExpr& c, Env& e
     return v.i;
   };
   Value v;
+  if (name == "REF") {  // the address of a variable: no value is read
+    if (c.args.size() != 1 || c.args[0].is_output || c.args[0].name) throw Unsupported("REF arguments");
+    Value* target = lvalue(*c.args[0].value, env);
+    v.t = ref_to(target->t);
+    v.ptr = target;
+    return v;
+  }
   if (name == "ABS") {
     args(1, 1);
     v = a[0];
@@ -1050,6 +1083,7 @@ void Reference::collect(const std::string& path, const Value& v, std::vector<Lea
       for (const auto& n : v.fb->vars.order) collect(path + "." + n, v.fb->vars.by_name.at(canon(n)), out);
       return;
     case VK::Itf:
+    case VK::Ref:
       return;  // a reference, not a value: what it refers to is compared where it is declared
     default:
       out.push_back(Leaf{path, v});

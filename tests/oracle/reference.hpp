@@ -23,7 +23,7 @@ struct RefTrap : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class VK { Bool, Int, Real, LReal, Time, String, Struct, Array, Fb, Itf };
+enum class VK { Bool, Int, Real, LReal, Time, String, Struct, Array, Fb, Itf, Ref };
 
 struct RType {
   VK kind = VK::Int;
@@ -31,7 +31,7 @@ struct RType {
   int bits = 0;              // Int: 8, 16, 32, 64
   bool is_signed = false;    // Int
   size_t max_len = 0;        // String
-  const RType* elem = nullptr;  // Array
+  const RType* elem = nullptr;  // Array element, Ref target
   int64_t lo = 0, hi = 0;       // Array bounds
   std::vector<std::pair<std::string, const RType*>> fields;  // Struct
   const st::Pou* pou = nullptr;                              // Fb
@@ -49,6 +49,7 @@ struct Value {
   std::vector<Value> elems;        // array elements, struct fields in declaration order
   std::shared_ptr<Instance> fb;    // Fb: the instance (owned where declared)
   Instance* ref = nullptr;         // Itf: the instance referred to, null when unassigned
+  Value* ptr = nullptr;            // Ref: the variable referred to (storage never moves), or null
 };
 
 // Variables of one POU instance (or one call frame): by canonical name, with the
@@ -90,6 +91,7 @@ class Reference {
 
   const RType* elementary(const std::string& canon_name) const;
   const RType* type_of(const st::TypeSpec& spec);
+  const RType* ref_to(const RType* target);
   Value make(const RType* t);
   void declare(Vars& vars, const std::vector<st::VarBlock>& blocks, Env* env);
   std::shared_ptr<Instance> instantiate(const st::Pou* pou);
@@ -120,6 +122,7 @@ class Reference {
   std::map<std::string, const st::TypeDecl*> type_decls_;
   std::vector<std::pair<std::string, std::shared_ptr<Instance>>> programs_;
   Vars globals_;
+  std::map<const RType*, const RType*> ref_types_;  // REF_TO T by T
   std::map<std::string, bool> for_vars_;  // canon names used as FOR control variables
   const RType* string255_ = nullptr;
   uint64_t steps_ = 0;
