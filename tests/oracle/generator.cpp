@@ -489,8 +489,13 @@ std::string Gen::stmt(const Scope& s, int depth) {
     std::vector<const Place*> io;
     for (const auto* p : w)
       if (p->t == fio_type_ && !p->bit) io.push_back(p);
-    if (io.size() >= 2) {
-      const Place* dst = io[static_cast<size_t>(pick(static_cast<int>(io.size())))];
+    // The result goes to a place without an index: whether the index is computed before
+    // or after FIO changes its VAR_IN_OUT is the implementation's choice.
+    std::vector<const Place*> plain;
+    for (const auto* p : io)
+      if (!p->indexed) plain.push_back(p);
+    if (io.size() >= 2 && !plain.empty()) {
+      const Place* dst = plain[static_cast<size_t>(pick(static_cast<int>(plain.size())))];
       const Place* ref = io[static_cast<size_t>(pick(static_cast<int>(io.size())))];
       return place_text(*dst, s, 1) + " := FIO(io := " + place_text(*ref, s, 1) + ", a := " + expr(fio_type_, s, ed) + ");";
     }
