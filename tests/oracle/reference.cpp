@@ -727,7 +727,10 @@ Value Reference::binary(st::BinaryOp op, const Value& a, const Value& b) {
       return v;
     }
     case VK::String:
-      if (op == B::Eq || op == B::Ne) return cmp(a.s == b.s ? 0 : 1);
+      if (is_cmp) {
+        int c = a.s.compare(b.s);  // byte order ('Z' < 'a'), a prefix before the longer string
+        return cmp(c < 0 ? -1 : c > 0 ? 1 : 0);
+      }
       throw Unsupported("string operator");
     default:
       throw Unsupported("operator on " + a.t->name);
