@@ -872,6 +872,34 @@ std::string Gen::program() {
   out_ << first;
   int n = 12 + pick(10);
   for (int i = 0; i < n; ++i) out_ << stmt(s, 2) << "\n";
+  out_ << "END_PROGRAM\n\n";
+
+  // A second PROGRAM, run after Main in each scan: it sees what Main left in the globals.
+  Scope a;
+  a.calls = functions_;
+  out_ << "PROGRAM Aux\nVAR\n";
+  for (int i = 0; i < 5; ++i) {
+    T t = any_scalar();
+    std::string nm = "x" + std::to_string(i);
+    out_ << "  " << nm << " : " << type_text(t) << " := " << literal(t) << ";\n";
+    a.places.push_back(Place{nm, "", t, true});
+  }
+  for (const auto& [gn, gt] : globals_) a.places.push_back(Place{gn, "", gt, true});
+  const FbInfo& ax = fbs_[2];
+  out_ << "  ax : " << ax.type << ";\n  loopA : DINT;\n  wa : DINT;\nEND_VAR\n";
+  a.insts.emplace_back("ax", 2);
+  for (const auto& [o, t] : ax.outputs) a.places.push_back(Place{"ax." + o, "", t, false});
+  for (auto c : ax.methods) {
+    c.prefix = "ax." + c.prefix;
+    a.calls.push_back(c);
+  }
+  for (auto c : ax.props) {
+    c.prefix = "ax." + c.prefix;
+    a.calls.push_back(c);
+  }
+  loop_vars_ = {"loopA"};
+  while_vars_ = {"wa"};
+  for (int i = 0; i < 4 + pick(4); ++i) out_ << stmt(a, 2) << "\n";
   out_ << "END_PROGRAM\n";
   return out_.str();
 }
