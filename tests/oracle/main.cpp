@@ -31,6 +31,7 @@ struct Options {
   GenOptions gen;
   uint64_t shrink_first = 1;  // failures shrunk (each costs up to thousands of runs)
   bool verbose = false;
+  bool self_check = false;
 };
 
 enum class Kind { Match, Mismatch, CompileError, Unsupported, RefTrap, EngineTrap, NativeError };
@@ -75,7 +76,7 @@ bool same(const st::Machine& m, const st::VarHandle& h, const Value& v, std::str
 
 // Compiles and runs one program in the interpreter (and natively when asked) and in the
 // reference evaluator, comparing every variable after every scan.
-Outcome check(const std::string& name, const std::string& text, int scans, bool native) {
+Outcome check(const std::string& name, const std::string& text, int scans, bool native, bool wrong_reference = false) {
   st::CompileOptions copt;
   copt.warnings = false;
   auto b = st::build_sources({{name, text}}, copt);
@@ -88,6 +89,7 @@ Outcome check(const std::string& name, const std::string& text, int scans, bool 
   std::unique_ptr<Reference> ref;
   try {
     ref = std::make_unique<Reference>(std::vector<const st::CompilationUnit*>{unit.get()});
+    ref->set_wrong_addition(wrong_reference);
   } catch (const Unsupported& e) {
     return {Kind::Unsupported, e.what()};
   } catch (const RefTrap& e) {
@@ -243,6 +245,7 @@ int usage() {
                "                    [--native-every M] [--out DIR] [--avoid method-args-with-calls]\n"
                "                    [--shrink-first N | --no-shrink] [--verbose] [FILE.st ...]\n"
                "       plcfi_oracle --seed S [--avoid ...] --emit     (prints the program of seed S)\n"
+               "       plcfi_oracle --self-check [--seed S --count N] (a wrong reference must be caught)\n"
                "Generates N programs from seeds S, S+1, ... (or takes the given files), runs K scans of each\n"
                "in the interpreter (and the native tier: --native every program, --native-every M every M-th)\n"
                "and in the reference evaluator, and compares every variable after every scan. Failing programs\n"
@@ -272,6 +275,7 @@ int run(int argc, char** argv) {
       else if (a == "--no-shrink") o.shrink_first = 0;
       else if (a == "--shrink-first") o.shrink_first = std::stoull(next());
       else if (a == "--verbose") o.verbose = true;
+      else if (a == "--self-check") o.self_check = true;
       else if (a == "--emit") {  // prints the program of --seed and stops
         std::fputs(generate_program(o.seed, o.gen).c_str(), stdout);
         return 0;
@@ -296,6 +300,18 @@ int run(int argc, char** argv) {
       std::fprintf(stderr, "plcfi_oracle: bad value for %s\n", a.c_str());
       return 2;
     }
+  }
+  if (o.self_check) {
+    // The comparison must catch a wrong reference: with integer additions off by one, most
+    // programs must mismatch (a few may add no integers that reach a variable).
+    uint64_t caught = 0;
+    for (uint64_t k = 0; k < o.count; ++k) {
+      std::string text = generate_program(o.seed + k, o.gen);
+      caught += check("self-check.st", text, o.scans, false, true).kind == Kind::Mismatch;
+    }
+    std::printf("self-check: %llu of %llu programs caught with a wrong reference\n", static_cast<unsigned long long>(caught),
+                static_cast<unsigned long long>(o.count));
+    return caught * 10 >= o.count * 9 ? 0 : 1;
   }
   std::filesystem::create_directories(o.out);
   std::map<Kind, uint64_t> counts;

@@ -682,7 +682,7 @@ Value Reference::binary(st::BinaryOp op, const Value& a, const Value& b) {
       }
       v.t = a.t;
       switch (op) {
-        case B::Add: v.i = norm(t, ua + ub); return v;
+        case B::Add: v.i = norm(t, ua + ub + (wrong_addition_ ? 1 : 0)); return v;
         case B::Sub: v.i = norm(t, ua - ub); return v;
         case B::Mul: v.i = norm(t, ua * ub); return v;
         case B::Div:

@@ -84,6 +84,9 @@ class Reference {
   // FOR control variables are left out (their value after the loop is the implementation's).
   std::vector<Leaf> leaves() const;
   static std::string text(const Value& v);  // for messages
+  // Self-check of the oracle: integer additions yield one more than they should, so that
+  // every comparison that reaches such a value must fail.
+  void set_wrong_addition(bool on) { wrong_addition_ = on; }
 
  private:
   struct Env;
@@ -126,6 +129,7 @@ class Reference {
   std::map<std::string, bool> for_vars_;  // canon names used as FOR control variables
   const RType* string255_ = nullptr;
   uint64_t steps_ = 0;
+  bool wrong_addition_ = false;
 };
 
 }  // namespace plcfi::oracle
