@@ -470,6 +470,12 @@ std::string Gen::stmt(const Scope& s, int depth) {
       for (size_t i = 0; i < f.step_params.size(); ++i)
         t += (i ? ", " : "") + f.step_params[i].first + " := " +
              (opt_.avoid_method_args_with_calls ? leaf(f.step_params[i].second, s) : expr(f.step_params[i].second, s, ed));
+      std::vector<const Place*> io;
+      for (const auto* p : w)
+        if (p->t == T::Dint && !p->bit) io.push_back(p);
+      // Every scope that calls Step has a writable DINT (cnt in FBs, acc in programs).
+      t += ", io := " + place_text(*io[static_cast<size_t>(pick(static_cast<int>(io.size())))], s,
+                                   opt_.avoid_method_args_with_calls ? 0 : 1);
       std::vector<const Place*> dst;
       for (const auto* p : w)
         if (p->t == f.step_output && !p->indexed) dst.push_back(p);
@@ -666,10 +672,12 @@ void Gen::fb(int k, bool implements, int inner) {
     step.places.push_back(Place{"d", "", f.step_params[0].second, false});
     f.step_output = any_scalar();
     // A FOR control variable must be local to the method.
+    // io, a VAR_IN_OUT: the caller's DINT, changed through its address.
     out_ << "METHOD Step\n" << pou_vars("VAR_INPUT", f.step_params) << pou_vars("VAR_OUTPUT", {{"q", f.step_output}})
-         << "VAR\n  " << loop << " : DINT;\nEND_VAR\n";
+         << pou_vars("VAR_IN_OUT", {{"io", T::Dint}}) << "VAR\n  " << loop << " : DINT;\nEND_VAR\n";
+    step.places.push_back(Place{"io", "", T::Dint, true});
     out_ << stmts(step, 2, 2, "\n") << "\n" << assign(Place{"q", "", f.step_output, true}, step, 2)
-         << "\ncnt := cnt + DINT#1;\nEND_METHOD\n";
+         << "\nio := io + " << expr(T::Dint, step, 2) << ";\ncnt := cnt + DINT#1;\nEND_METHOD\n";
     // The body.
     loop_vars_.clear();
     out_ << stmts(s, 3, 2, "\n") << "\nEND_FUNCTION_BLOCK\n\n";
@@ -791,7 +799,8 @@ std::string Gen::program() {
     Place p{n, "", t, true, true, lo, hi};
     s.places.push_back(p);
   }
-  out_ << "  r1 : Rec;\n  rs : ARRAY[1..3] OF Rec;\n";
+  out_ << "  r1 : Rec;\n  rs : ARRAY[1..3] OF Rec;\n  acc : DINT;\n";
+  s.places.push_back(Place{"acc", "", T::Dint, true});
   for (const auto& [n, t] : fields) {
     s.places.push_back(Place{"r1." + n, "", t, true});
     s.places.push_back(Place{"rs", "." + n, t, true, true, 1, 3});
@@ -886,7 +895,8 @@ std::string Gen::program() {
   }
   for (const auto& [gn, gt] : globals_) a.places.push_back(Place{gn, "", gt, true});
   const FbInfo& ax = fbs_[2];
-  out_ << "  ax : " << ax.type << ";\n  loopA : DINT;\n  wa : DINT;\nEND_VAR\n";
+  out_ << "  ax : " << ax.type << ";\n  acc : DINT;\n  loopA : DINT;\n  wa : DINT;\nEND_VAR\n";
+  a.places.push_back(Place{"acc", "", T::Dint, true});
   a.insts.emplace_back("ax", 2);
   for (const auto& [o, t] : ax.outputs) a.places.push_back(Place{"ax." + o, "", t, false});
   for (auto c : ax.methods) {
