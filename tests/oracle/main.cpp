@@ -126,6 +126,12 @@ Outcome check(const std::string& name, const std::string& text, int scans, bool 
           }
       }
       if (result.kind != Kind::Match) break;
+      // The two tiers must also agree on what the reference does not compare (FOR control
+      // variables, interface and reference slots, padding): the whole memory.
+      if (nat && std::memcmp(interp.mem(), nat->mem(), interp.mem_size()) != 0) {
+        result = {Kind::Mismatch, "after scan " + std::to_string(s + 1) + ": the interpreter's and the native tier's memory differ"};
+        break;
+      }
       try {
         ref->scan();
       } catch (const RefTrap& e) {
