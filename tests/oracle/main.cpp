@@ -1,5 +1,6 @@
 // plcfi_oracle: differential testing of the ST engine (interpreter and native tier) against
 // the reference evaluator, on random programs from the generator or on given files.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -235,6 +236,28 @@ std::string shrink(const std::string& text, int scans, bool native, Outcome* fai
       const std::string& l = lines[i];
       if (l.empty() || l.back() != ';' || l.rfind("END_", 0) == 0) continue;
       if (attempt(i, i + 1)) changed = true;
+    }
+    // Inside a compound statement's line: delete one `...;` piece at a time (a piece that
+    // is not a whole statement leaves a program the compiler rejects, so it stays).
+    for (size_t i = 0; i < lines.size() && tries < max_tries; ++i) {
+      for (size_t end = lines[i].size(); end > 0 && tries < max_tries;) {
+        size_t semi = lines[i].rfind(';', end - 1);
+        if (semi == std::string::npos || semi == 0) break;
+        size_t prev = lines[i].rfind(';', semi - 1);
+        size_t from = prev == std::string::npos ? 0 : prev + 1;
+        std::vector<std::string> cand = lines;
+        cand[i].erase(from, semi + 1 - from);
+        ++tries;
+        Outcome o = check("shrink.st", join(cand), scans, native);
+        if (same_failure(o, *failure)) {
+          lines = std::move(cand);
+          *failure = o;
+          changed = true;
+          end = std::min(from, lines[i].size());
+        } else {
+          end = from;
+        }
+      }
     }
   }
   return join(lines);
