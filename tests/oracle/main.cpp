@@ -1,6 +1,7 @@
 // plcfi_oracle: differential testing of the ST engine (interpreter and native tier) against
 // the reference evaluator, on random programs from the generator or on given files.
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -222,19 +223,24 @@ std::string shrink(const std::string& text, int scans, bool native, Outcome* fai
                                      {"GET", "END_GET"}};
   for (bool changed = true; changed && tries < max_tries;) {
     changed = false;
+    // Keywords may be in any case (the generator scrambles some).
+    auto upper = [](std::string t) {
+      for (char& ch : t) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+      return t;
+    };
     for (const auto& b : kBlocks) {
       for (size_t i = lines.size(); i-- > 0;) {
-        if (i >= lines.size() || lines[i].rfind(b[0], 0) != 0) continue;
+        if (i >= lines.size() || upper(lines[i]).rfind(b[0], 0) != 0) continue;
         if (std::string(b[0]) == "VAR" && lines[i].find(' ') != std::string::npos) continue;
         size_t j = i + 1;
-        while (j < lines.size() && lines[j] != b[1] && lines[j].rfind(std::string(b[1]) + " ", 0) != 0) ++j;
+        while (j < lines.size() && upper(lines[j]) != b[1] && upper(lines[j]).rfind(std::string(b[1]) + " ", 0) != 0) ++j;
         if (j < lines.size() && attempt(i, j + 1)) changed = true;
       }
     }
     for (size_t i = lines.size(); i-- > 0;) {
       if (i >= lines.size()) continue;
       const std::string& l = lines[i];
-      if (l.empty() || l.back() != ';' || l.rfind("END_", 0) == 0) continue;
+      if (l.empty() || l.back() != ';' || upper(l).rfind("END_", 0) == 0) continue;
       if (attempt(i, i + 1)) changed = true;
     }
     // Inside a compound statement's line: delete one `...;` piece at a time (a piece that
