@@ -58,6 +58,18 @@ bool is_const(const std::string& e) {
   return true;
 }
 
+// An integer type that converts implicitly to t (IEC widening), or t itself when none.
+T narrower(T t, int r) {
+  static const T kSigned[] = {T::Sint, T::Int, T::Dint, T::Lint};
+  static const T kUnsigned[] = {T::Usint, T::Uint, T::Udint};
+  std::vector<T> ok;
+  for (T u : kSigned)
+    if (is_signed(t) && width(u) < width(t)) ok.push_back(u);
+  for (T u : kUnsigned)
+    if (width(u) < width(t) && (is_signed(t) || !is_signed(u))) ok.push_back(u);
+  return ok.empty() ? t : ok[static_cast<size_t>(r) % ok.size()];
+}
+
 const T kScalars[] = {T::Bool, T::Sint, T::Int, T::Dint, T::Lint, T::Usint, T::Uint, T::Udint,
                       T::Byte, T::Word, T::Dword, T::Real, T::LReal, T::Time, T::Str};
 
@@ -226,7 +238,9 @@ std::string Gen::call_text(const Callable& c, const Scope& s, int depth) {
       continue;
     }
     bool plain = c.is_method && opt_.avoid_method_args_with_calls;
-    text += plain ? leaf(c.params[i].second, s) : expr(c.params[i].second, s, depth - 1);
+    T pt = c.params[i].second;
+    if (is_int(pt) && chance(15)) pt = narrower(pt, pick(8));  // widened by the call
+    text += plain ? leaf(pt, s) : expr(pt, s, depth - 1);
   }
   return text + ")";
 }
@@ -273,6 +287,15 @@ std::string Gen::expr(T t, const Scope& s, int depth) {
   if (is_int(t)) {
     std::string n = name(t);
     alts.push_back([&] { return arith(t, " * "); });
+    // Mixed operands: the narrower one is widened implicitly.
+    alts.push_back([&] {
+      T u = narrower(t, pick(8));
+      std::string a = sub(t), b = sub(u);
+      if (is_const(a) && is_const(b)) a = variable(t, s);
+      if (a.empty()) return sub(t);
+      static const char* kOps[] = {" + ", " - ", " * "};
+      return chance(50) ? "(" + a + kOps[pick(3)] + b + ")" : "(" + b + kOps[pick(3)] + a + ")";
+    });
     alts.push_back([&, n] {
       auto [a, d] = operands(t);
       if (a.empty()) return sub(t);
@@ -365,7 +388,8 @@ std::string Gen::expr(T t, const Scope& s, int depth) {
 }
 
 std::string Gen::assign(const Place& p, const Scope& s, int depth) {
-  std::string rhs = expr(p.t, s, depth);
+  // Now and then a narrower integer, widened by the assignment.
+  std::string rhs = is_int(p.t) && chance(15) ? expr(narrower(p.t, pick(8)), s, depth) : expr(p.t, s, depth);
   // Stored REALs stay within +-1e6, so that no chain of statements reaches infinity.
   if (is_real(p.t)) rhs = "LIMIT(-" + std::string(name(p.t)) + "#1000000.0, " + rhs + ", " + name(p.t) + "#1000000.0)";
   return place_text(p, s, 2) + " := " + rhs + ";";

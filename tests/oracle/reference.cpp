@@ -659,6 +659,15 @@ Value Reference::binary(st::BinaryOp op, const Value& a, const Value& b) {
     }
     return v;
   }
+  // Implicit widening of integers (SINT -> INT -> DINT -> LINT, USINT -> ... -> ULINT, an
+  // unsigned type to a wider signed one): the narrower operand takes the wider type.
+  if (a.t->kind == VK::Int && b.t->kind == VK::Int && a.t != b.t) {
+    auto widens = [](const RType* from, const RType* to) {
+      return from->bits < to->bits && (from->is_signed == to->is_signed || (!from->is_signed && to->is_signed));
+    };
+    if (widens(a.t, b.t)) return binary(op, convert(a, b.t), b);
+    if (widens(b.t, a.t)) return binary(op, a, convert(b, a.t));
+  }
   if (a.t->kind != b.t->kind || (a.t->kind == VK::Int && a.t != b.t))
     throw Unsupported("operands of different types: " + a.t->name + ", " + b.t->name);
   switch (a.t->kind) {
