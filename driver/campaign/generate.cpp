@@ -35,6 +35,7 @@ std::string address_text(const rt::ImageRef& r) {
 namespace {
 
 constexpr const char* kPreProgram = "__FI_PRECONDITIONS";
+constexpr size_t kPreconditionFirstLine = 4;  // of the precondition program
 
 bool is_bool(const st::Type* t) { return t && t->kind == st::TypeKind::Bool; }
 
@@ -92,53 +93,28 @@ std::string substitute(std::string text, const std::map<std::string, std::string
   return text;
 }
 
-// Rewrites diagnostics located in the generated precondition program to the TSD step
-// they come from (the generated text is one line per case).
-void remap_preconditions(st::Build& b, const std::vector<TestCase>& cases, const std::string& tsd_path) {
-  uint32_t gen = UINT32_MAX, tsd = UINT32_MAX;
-  for (uint32_t f = 0; f < b.sm.size(); ++f)
-    if (b.sm.file(f).path == "<preconditions>") gen = f;
-  std::string e;
-  if (gen == UINT32_MAX || !b.sm.load(tsd_path, &tsd, &e)) return;
-  auto& diags = const_cast<std::vector<st::Diagnostic>&>(b.diags.all());
-  for (auto& d : diags) {
-    if (d.loc.file != gen) continue;
-    size_t idx = d.loc.line >= 4 ? d.loc.line - 4 : SIZE_MAX;
-    if (idx >= cases.size()) continue;
-    const TestCase& c = cases[idx];
-    d.message += " (in the precondition of " + c.scenario->id + "." + c.step->id + ": " + c.precondition + ")";
+// Where each line of the precondition program comes from: one line per case, pointing
+// at the TSD step's precondition (the text is assembled from its entries, so a message
+// points at the step's first entry, whatever the column).
+std::vector<st::LineOrigin> precondition_origins(const std::vector<TestCase>& cases, const std::string& tsd_path) {
+  std::vector<st::LineOrigin> origins(kPreconditionFirstLine - 1);
+  for (const TestCase& c : cases) {
     const Loc& at = c.step->pre.empty() ? c.step->loc : c.step->pre.front().loc;
-    d.loc = st::SourceLoc{tsd, at.line, at.col};
+    st::LineOrigin o;
+    o.path = tsd_path;
+    o.line = at.line;
+    o.col = at.col;
+    o.exact_columns = false;
+    o.context = "in the precondition of " + c.scenario->id + "." + c.step->id + ": " + c.precondition;
+    origins.push_back(std::move(o));
   }
-}
-
-// A class formula is compiled once per test case, with that case's values in place of the
-// placeholders: point each message at the formula's start (columns after a placeholder
-// would not match the file) and report it once.
-void tidy_class_diagnostics(st::Build& b, const FaultClasses& classes) {
-  uint32_t file = UINT32_MAX;
-  for (uint32_t f = 0; f < b.sm.size(); ++f)
-    if (b.sm.file(f).path == classes.path) file = f;
-  if (file == UINT32_MAX) return;
-  std::map<uint32_t, uint32_t> formula_col;  // line -> column of the formula's text
-  for (const auto& c : classes.classes) {
-    for (const auto& r : c.requirements)
-      for (const auto* f : {&r.trigger, &r.invariant, &r.final, &r.delay, &r.reaction, &r.release})
-        if (f->line) formula_col[f->line] = f->col;
-    for (const auto& fb : c.forbidden) formula_col[fb.formula.line] = fb.formula.col;
-  }
-  auto& diags = const_cast<std::vector<st::Diagnostic>&>(b.diags.all());
-  for (auto& d : diags) {
-    if (d.loc.file != file) continue;
-    auto it = formula_col.find(d.loc.line);
-    if (it != formula_col.end()) d.loc.col = it->second;
-  }
-  b.diags.remove_duplicates();
+  return origins;
 }
 
 }  // namespace
 
 std::string precondition_program(const std::vector<TestCase>& cases) {
+  // kPreconditionFirstLine - 1 lines before the first case's.
   std::string s = fmt::format("PROGRAM {}\nVAR_OUTPUT pre : ARRAY[0..{}] OF BOOL; END_VAR\n(* one line per test case *)\n",
                               kPreProgram, cases.empty() ? 0 : cases.size() - 1);
   for (size_t i = 0; i < cases.size(); ++i) s += fmt::format("pre[{}] := {};\n", i, cases[i].precondition);
@@ -313,12 +289,11 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   // 4. Everything in one build.
   out->monitor_source = monitor::generate_monitors(out->monitors);
   out->preconditions_source = precondition_program(out->cases);
-  st::NamedSources late = {{"<preconditions>", out->preconditions_source},
-                           {out->monitor_source.name, out->monitor_source.text}};
+  // Class formulas are instantiated per case with other text in their placeholders:
+  // their messages point at the formula's start.
+  st::GeneratedSources late = {{"<preconditions>", out->preconditions_source, precondition_origins(out->cases, c.tsd.path)},
+                               out->monitor_source.source(out->monitors.path, false)};
   out->build = st::build_files(c.programs, opt, late);
-  monitor::remap_diagnostics(*out->build, out->monitor_source, out->monitors);
-  tidy_class_diagnostics(*out->build, c.classes);
-  remap_preconditions(*out->build, out->cases, c.tsd.path);
   if (!out->build->ok()) {
     *err = out->build->diags.render_all();
     return false;

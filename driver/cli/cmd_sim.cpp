@@ -155,20 +155,19 @@ int cmd_sim(const std::vector<std::string>& args) {
   std::string err;
   monitor::RequirementsFile reqs;
   monitor::MonitorSource mon;
-  st::NamedSources late;
+  st::GeneratedSources late;
   if (vm.count("requirements")) {
     if (!monitor::load_requirements(vm["requirements"].as<std::string>(), &reqs, &err)) {
       std::cerr << err << "\n";
       return 2;
     }
     mon = monitor::generate_monitors(reqs);
-    late.emplace_back(mon.name, mon.text);
+    late.push_back(mon.source(reqs.path));
   }
   st::CompileOptions opt;
   opt.warnings = false;
   auto b = st::build_files(files, opt, late);
   for (const auto& e : b->io_errors) std::cerr << e << "\n";
-  if (!late.empty()) monitor::remap_diagnostics(*b, mon, reqs);
   std::cerr << b->diags.render_all();
   if (!b->ok()) return 2;
   const st::Application& app = *b->app;

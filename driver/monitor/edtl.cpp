@@ -258,26 +258,23 @@ MonitorSource generate_monitors(const RequirementsFile& reqs) {
   return src;
 }
 
-void remap_diagnostics(st::Build& build, const MonitorSource& src, const RequirementsFile& reqs) {
-  uint32_t gen = UINT32_MAX, yaml = UINT32_MAX;
-  for (uint32_t f = 0; f < build.sm.size(); ++f)
-    if (build.sm.file(f).path == src.name) gen = f;
-  if (gen == UINT32_MAX) return;
-  std::string e;
-  if (!build.sm.load(reqs.path, &yaml, &e)) return;
-  // DiagEngine keeps its diagnostics; rewrite their locations in place.
-  auto& diags = const_cast<std::vector<st::Diagnostic>&>(build.diags.all());
-  for (auto& d : diags) {
-    if (d.loc.file != gen || d.loc.line == 0 || d.loc.line > src.lines.size()) continue;
-    const auto& li = src.lines[d.loc.line - 1];
+st::GeneratedSource MonitorSource::source(const std::string& reqs_path, bool exact_columns) const {
+  std::vector<st::LineOrigin> origins(lines.size());
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const LineInfo& li = lines[i];
+    st::LineOrigin& o = origins[i];
     if (!li.formula || li.formula->line == 0) {
-      d.message += " (in a default formula)";
+      o.context = "in a default formula";
       continue;
     }
-    uint32_t col = d.loc.col > li.prefix ? d.loc.col - li.prefix - 1 : 0;
-    uint32_t src_col = col < li.pos_map.size() ? li.pos_map[col] : (li.pos_map.empty() ? 0 : li.pos_map.back() + 1);
-    d.loc = st::SourceLoc{yaml, li.formula->line, li.formula->col + src_col};
+    o.path = reqs_path;
+    o.line = li.formula->line;
+    o.col = li.formula->col;
+    o.prefix = li.prefix;
+    o.col_map = li.pos_map;
+    o.exact_columns = exact_columns;
   }
+  return st::GeneratedSource(name, text, std::move(origins));
 }
 
 // ------------------------------------------------------------------ checking
@@ -500,8 +497,7 @@ bool check_trace(const RequirementsFile& reqs, const std::string& trace_path, in
   auto mon = generate_monitors(reqs);
   st::CompileOptions opt;
   opt.warnings = false;
-  auto b = st::build_sources({{"<trace:" + trace_path + ">", program}}, opt, {{mon.name, mon.text}});
-  remap_diagnostics(*b, mon, reqs);
+  auto b = st::build_sources({{"<trace:" + trace_path + ">", program}}, opt, {mon.source(reqs.path)});
   if (!b->ok()) {
     *error = b->diags.render_all();
     return false;

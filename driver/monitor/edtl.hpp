@@ -50,12 +50,14 @@ struct MonitorSource {
     std::vector<uint32_t> pos_map;
   };
   std::vector<LineInfo> lines;  // index = generated line - 1
+
+  // The monitors as a late source of a build, each formula line pointing at the formula
+  // in `reqs_path`, so diagnostics show the user's text. `exact_columns` false when the
+  // formulas were instantiated with other text (a campaign's fault-class placeholders):
+  // messages then point at the formula's start.
+  st::GeneratedSource source(const std::string& reqs_path, bool exact_columns = true) const;
 };
 MonitorSource generate_monitors(const RequirementsFile& reqs);
-
-// Rewrites diagnostics located in the generated monitor source to the requirements file
-// (which is added to the build's source manager so messages show the formula).
-void remap_diagnostics(st::Build& build, const MonitorSource& src, const RequirementsFile& reqs);
 
 enum class Cause { Invariant, Delay };
 

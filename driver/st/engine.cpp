@@ -27,12 +27,12 @@ void st(uint8_t* p, T v) {
 }
 
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32_t>& files, const CompileOptions& opt,
-                              const NamedSources& late) {
+                              const GeneratedSources& late) {
   for (uint32_t f : files) {
     if (is_test_file(b->sm, f)) b->tests.push_back(parse_test_file(b->sm, f, b->diags));
     else b->units.push_back(parse_unit(b->sm, f, b->diags));
   }
-  for (const auto& [name, text] : late) b->late.push_back(parse_unit(b->sm, b->sm.add(name, text), b->diags));
+  for (const auto& g : late) b->late.push_back(parse_unit(b->sm, b->sm.add_generated(g.name, g.text, g.origins), b->diags));
   if (b->diags.has_errors() || !b->io_errors.empty()) return b;
   std::vector<const CompilationUnit*> units;
   for (const auto& u : b->units) units.push_back(u.get());
@@ -47,7 +47,7 @@ std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32
 uint32_t add_stdlib(Build& b) { return b.sm.add("<stdlib>", stdlib_source()); }
 }  // namespace
 
-std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt, const NamedSources& late) {
+std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt, const GeneratedSources& late) {
   auto b = std::make_unique<Build>();
   std::vector<uint32_t> files{add_stdlib(*b)};
   for (const auto& p : paths) {
@@ -62,7 +62,7 @@ std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const 
   return finish(std::move(b), files, opt, late);
 }
 
-std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileOptions& opt, const NamedSources& late) {
+std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileOptions& opt, const GeneratedSources& late) {
   auto b = std::make_unique<Build>();
   std::vector<uint32_t> files{add_stdlib(*b)};
   for (const auto& [name, text] : sources) files.push_back(b->sm.add(name, text));

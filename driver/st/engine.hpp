@@ -31,12 +31,21 @@ struct Build {
 };
 
 using NamedSources = std::vector<std::pair<std::string, std::string>>;
+// Generated ST (requirement monitors, preconditions) with, per line, where its text came
+// from: diagnostics in it point into the user's files.
+struct GeneratedSource {
+  GeneratedSource(std::string n, std::string t, std::vector<LineOrigin> o = {})
+      : name(std::move(n)), text(std::move(t)), origins(std::move(o)) {}
+  std::string name, text;
+  std::vector<LineOrigin> origins;
+};
+using GeneratedSources = std::vector<GeneratedSource>;
 // Reads and compiles files. Returns the build; check ok(), diags and io_errors. `late`
 // sources (requirement monitors) are compiled after the program instances exist.
 std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt,
-                                   const NamedSources& late = {});
+                                   const GeneratedSources& late = {});
 // Same from in-memory sources (name, text): tests, benchmarks, trace programs.
-std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileOptions& opt, const NamedSources& late = {});
+std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileOptions& opt, const GeneratedSources& late = {});
 
 // A variable resolved once from its path (`Main.seq.step`, `GVL.x`, `x`, `%IX0.3`,
 // `Main.buf[3].v`, `Main.w.2`) to a typed location; reads and writes are O(1).

@@ -6,26 +6,34 @@
 
 namespace plcfi::st {
 
-namespace {
-Diagnostic& push(std::vector<Diagnostic>& v, Diagnostic& overflow, Severity sev, std::string code,
-                 SourceLoc loc, std::string msg) {
-  if (v.size() >= DiagEngine::kMaxStored) {
-    overflow = Diagnostic{};
-    return overflow;
+Diagnostic& DiagEngine::report(Severity sev, std::string code, SourceLoc loc, std::string message) {
+  std::string context;
+  loc = sm_->origin(loc, &context);
+  if (!context.empty()) message += " (" + context + ")";
+  std::string key = code + '\x1f' + std::to_string(loc.file) + ':' + std::to_string(loc.line) + ':' + std::to_string(loc.col) +
+                    '\x1f' + message;
+  if (!seen_.insert(key).second) {
+    for (auto& d : diags_)
+      if (d.code == code && d.loc.file == loc.file && d.loc.line == loc.line && d.loc.col == loc.col && d.message == message)
+        return d;
+    overflow_ = Diagnostic{};  // the first one came after the cap: counted then, not again
+    return overflow_;
   }
-  v.push_back(Diagnostic{sev, std::move(code), std::move(msg), loc, {}});
-  return v.back();
+  ++(sev == Severity::Error ? errors_ : warnings_);
+  if (diags_.size() >= kMaxStored) {
+    overflow_ = Diagnostic{};
+    return overflow_;
+  }
+  diags_.push_back(Diagnostic{sev, std::move(code), std::move(message), loc, {}});
+  return diags_.back();
 }
-}  // namespace
 
 Diagnostic& DiagEngine::error(std::string code, SourceLoc loc, std::string message) {
-  ++errors_;
-  return push(diags_, overflow_, Severity::Error, std::move(code), loc, std::move(message));
+  return report(Severity::Error, std::move(code), loc, std::move(message));
 }
 
 Diagnostic& DiagEngine::warning(std::string code, SourceLoc loc, std::string message) {
-  ++warnings_;
-  return push(diags_, overflow_, Severity::Warning, std::move(code), loc, std::move(message));
+  return report(Severity::Warning, std::move(code), loc, std::move(message));
 }
 
 static void render_loc(std::string& out, const SourceManager& sm, SourceLoc loc) {
@@ -57,23 +65,6 @@ std::string DiagEngine::render(const Diagnostic& d) const {
     out += ": note: " + text + "\n";
   }
   return out;
-}
-
-void DiagEngine::remove_duplicates() {
-  std::vector<Diagnostic> kept;
-  for (auto& d : diags_) {
-    bool dup = false;
-    for (const auto& k : kept)
-      dup = dup || (k.loc.file == d.loc.file && k.loc.line == d.loc.line && k.loc.col == d.loc.col && k.code == d.code &&
-                    k.message == d.message);
-    if (!dup) {
-      kept.push_back(std::move(d));
-      continue;
-    }
-    if (d.severity == Severity::Error) --errors_;
-    else --warnings_;
-  }
-  diags_ = std::move(kept);
 }
 
 std::string DiagEngine::render_all() const {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "source.hpp"
@@ -24,6 +25,10 @@ class DiagEngine {
  public:
   explicit DiagEngine(const SourceManager& sm) : sm_(&sm) {}
 
+  // A location in generated text is reported where that text came from (the source
+  // manager's origins), with the origin's context added to the message. A diagnostic
+  // identical to one already reported (generated code instantiating one user formula
+  // several times) is not reported again: the earlier one is returned.
   Diagnostic& error(std::string code, SourceLoc loc, std::string message);
   Diagnostic& warning(std::string code, SourceLoc loc, std::string message);
 
@@ -34,17 +39,16 @@ class DiagEngine {
   // Caps runaway output on garbage input; further errors are counted but not stored.
   static constexpr size_t kMaxStored = 500;
 
-  // Drops repeated diagnostics (same location, code and message), e.g. from generated
-  // code that instantiates one user formula several times.
-  void remove_duplicates();
-
   // Renders one diagnostic with its source line and caret.
   std::string render(const Diagnostic& d) const;
   std::string render_all() const;
 
  private:
+  Diagnostic& report(Severity sev, std::string code, SourceLoc loc, std::string message);
+
   const SourceManager* sm_;
   std::vector<Diagnostic> diags_;
+  std::unordered_set<std::string> seen_;  // code, location and message of each stored one
   Diagnostic overflow_;
   size_t errors_ = 0;
   size_t warnings_ = 0;

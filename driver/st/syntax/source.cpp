@@ -33,6 +33,45 @@ bool SourceManager::load(const std::string& path, uint32_t* index, std::string* 
   return true;
 }
 
+uint32_t SourceManager::add_generated(std::string name, std::string text, std::vector<LineOrigin> origins) {
+  std::vector<SourceFile::Origin> resolved;
+  resolved.reserve(origins.size());
+  for (auto& o : origins) {
+    SourceFile::Origin r;
+    if (!o.path.empty() && o.line != 0) {
+      bool found = false;
+      for (uint32_t f = 0; f < files_.size() && !found; ++f)
+        if (files_[f]->path == o.path && files_[f]->origins.empty()) r.file = f, found = true;
+      std::string err;
+      if (!found && !load(o.path, &r.file, &err)) o.line = 0;
+    }
+    r.where = std::move(o);
+    resolved.push_back(std::move(r));
+  }
+  uint32_t index = add(std::move(name), std::move(text));
+  files_[index]->origins = std::move(resolved);
+  return index;
+}
+
+SourceLoc SourceManager::origin(SourceLoc loc, std::string* context) const {
+  if (loc.file >= files_.size() || loc.line == 0) return loc;
+  const auto& origins = files_[loc.file]->origins;
+  if (loc.line > origins.size()) return loc;
+  const auto& [o, file] = origins[loc.line - 1];
+  if (o.line == 0) {
+    if (context && !o.context.empty()) *context = o.context;
+    return loc;
+  }
+  if (context) *context = o.context;
+  uint32_t col = o.col;
+  if (o.exact_columns && loc.col > o.prefix) {
+    uint32_t offset = loc.col - o.prefix - 1;
+    if (!o.col_map.empty()) offset = offset < o.col_map.size() ? o.col_map[offset] : o.col_map.back() + 1;
+    col += offset;
+  }
+  return SourceLoc{file, o.line, col};
+}
+
 std::string canon(std::string_view name) {
   std::string out(name);
   for (char& c : out) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));

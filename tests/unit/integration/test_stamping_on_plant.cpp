@@ -28,7 +28,7 @@ struct Cell {
   std::unique_ptr<io::SimBackend> backend;
   std::unique_ptr<rt::Runtime> runtime;
 
-  explicit Cell(const std::string& program, uint64_t seed = 1, const st::NamedSources& late = {}) {
+  explicit Cell(const std::string& program, uint64_t seed = 1, const st::GeneratedSources& late = {}) {
     build = st::build_files({program_path(program)}, st::CompileOptions{}, late);
     EXPECT_TRUE(build->ok()) << build->diags.render_all();
     std::string err;
