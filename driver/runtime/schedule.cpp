@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <numeric>
 
 #include "syntax/source.hpp"
@@ -79,7 +81,14 @@ bool parse_duration(const std::string& text_in, int64_t* ns, std::string* err) {
       *err = "'" + text_in + "' is not a duration (e.g. 10ms, 1s, 2m30s)";
       return false;
     }
-    double value = std::stod(text.substr(i, j - i));
+    // strtod, not std::stod: "." or 400 digits are a bad duration, not an exception.
+    std::string digits = text.substr(i, j - i);
+    char* end = nullptr;
+    double value = std::strtod(digits.c_str(), &end);
+    if (end != digits.c_str() + digits.size() || !std::isfinite(value)) {
+      *err = "'" + text_in + "' is not a duration (e.g. 10ms, 1s, 2m30s)";
+      return false;
+    }
     size_t k = j;
     while (k < text.size() && std::isalpha(static_cast<unsigned char>(text[k]))) ++k;
     std::string unit = text.substr(j, k - j);
@@ -96,7 +105,7 @@ bool parse_duration(const std::string& text_in, int64_t* ns, std::string* err) {
       return false;
     }
     double v = value * mul;
-    if (v > 9.2e18) {
+    if (v > 9.2e18 || static_cast<double>(total) + v > 9.2e18) {
       *err = "'" + text_in + "' is too long";
       return false;
     }
