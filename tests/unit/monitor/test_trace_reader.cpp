@@ -164,9 +164,9 @@ TEST(TraceReaderCsv, FiftyThousandColumnsTakeLinearTime) {
     EXPECT_EQ(handles[i].addr, one->addr);
     EXPECT_EQ(handles[i].type, one->type);
   }
-  // Linear: about 20 ms; the quadratic reader needed seconds. Generous for loaded
-  // machines and sanitizer builds.
-  EXPECT_LT(seconds_since(t0), 5.0);
+  // Linear: under a second in a RelWithDebInfo build (a column-by-column st::resolve
+  // took about 15 s). Generous for loaded machines and sanitizer builds.
+  EXPECT_LT(seconds_since(t0), 10.0);
 }
 
 TEST(TraceReaderCsv, OverlongLineIsAnError) {
