@@ -506,13 +506,9 @@ bool check_trace(const RequirementsFile& reqs, const std::string& trace_path, in
   if (!set) return false;
   st::Machine m(*b->app);
   std::vector<st::VarHandle> handles;
-  for (const auto& c : reader->columns()) {
-    auto h = st::resolve(*b->app, c.name, error);
-    if (!h) {
-      *error = trace_path + ": column " + c.name + ": " + *error;
-      return false;
-    }
-    handles.push_back(*h);
+  if (!resolve_trace_columns(*b->app, reader->columns(), &handles, error)) {
+    *error = trace_path + ": " + *error;
+    return false;
   }
   std::vector<double> values;
   int64_t t = 0;

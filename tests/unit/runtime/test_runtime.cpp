@@ -317,6 +317,12 @@ TEST(Runtime, DurationsParseLikeIecLiterals) {
   EXPECT_EQ(1'500'000'000, ns);
   EXPECT_FALSE(parse_duration("10 parsecs", &ns, &err));
   EXPECT_FALSE(parse_duration("", &ns, &err));
+  // Found by fuzzing the fault models (delayed(.s) threw std::invalid_argument from stod).
+  EXPECT_FALSE(parse_duration(".s", &ns, &err));
+  EXPECT_EQ(err, "'.s' is not a duration (e.g. 10ms, 1s, 2m30s)");
+  EXPECT_FALSE(parse_duration("1.2.3s", &ns, &err));
+  EXPECT_FALSE(parse_duration(std::string(400, '9') + "s", &ns, &err));
+  EXPECT_FALSE(parse_duration("100000d100000d", &ns, &err));
   EXPECT_FALSE(parse_duration("5x", &ns, &err));
   EXPECT_EQ(err, "'5x' is not a duration: unknown duration unit 'x' (use d, h, m, s, ms, us or ns)");
   // Exact decimal arithmetic (no double): 8.2 ms is 8,200,000 ns, not 8,199,999.

@@ -1,0 +1,50 @@
+// Fuzz target: the ST front end (lexer, parser, semantic checks, bytecode compiler) on one
+// source; a program that compiles runs a few scans under a small VM budget (the watchdog).
+#include <cstdint>
+#include <string>
+
+#include "engine.hpp"
+#include "fuzz_support.hpp"
+#include "runtime/schedule.hpp"
+
+namespace {
+
+constexpr uint64_t kScans = 4;
+// Backward jumps per call: a loop without end traps (Watchdog) instead of hanging.
+constexpr uint64_t kBudget = 20'000;
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace plcfi;
+  st::CompileOptions opt;
+  opt.warnings = true;
+  auto b = st::build_sources({{"fuzz.st", std::string(fuzz::as_text(data, size))}}, opt);
+  (void)b->diags.render_all();
+  if (!b->ok()) return 0;
+  const st::Application& app = *b->app;
+  rt::Schedule sched;
+  std::string err;
+  bool scheduled = app.has_configuration ? sched.from_configuration(app, &err)
+                                         : sched.single_program(app, "", 10'000'000, &err);
+  if (!scheduled) return 0;
+  st::Machine m(app);
+  m.set_budget(kBudget);
+  bool trapped = false;
+  for (uint64_t n = 0; n < kScans && !trapped; ++n) {
+    m.set_now(static_cast<int64_t>(n) * sched.tick_ns());
+    m.clear_taken();
+    sched.for_each_due(n, [&](const rt::ScheduledTask& t) {
+      for (size_t pi : t.programs) {
+        if (trapped) return;
+        const auto& inst = app.programs[pi];
+        if (!m.call(inst.pou->entry, inst.addr)) {
+          (void)st::describe_trap(app, m.trap());
+          trapped = true;
+        }
+      }
+    });
+    m.merge_coverage();
+  }
+  return 0;
+}
