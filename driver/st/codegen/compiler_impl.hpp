@@ -238,6 +238,7 @@ class Compiler {
 
   // ---- calls (calls.cpp)
   Val call(const CallExpr& c, bool as_statement);
+  bool may_call(const Expr& e) const;
   Val call_function(PouInfo* f, const CallExpr& c);
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
