@@ -284,7 +284,17 @@ class Compiler {
   std::vector<std::unique_ptr<PouInfo>> test_pous_;
   std::vector<std::unique_ptr<Pou>> synthetic_;
   uint32_t next_type_id_ = 1;
-  bool instance_paths_ = false;  // while compiling late units: Main.x names an instance variable
+  bool instance_paths_ = false;
+  uint32_t const_depth_ = 0;  // const_eval() recursion (constants defined through constants)
+  bool const_depth_reported_ = false;  // each depth error once per compilation: every
+                                      // declaration along a long chain would hit it again
+  static constexpr uint32_t kMaxConstDepth = 512;
+  uint32_t type_depth_ = 0;  // resolve_type() recursion (named types holding named types)
+  bool type_depth_reported_ = false;
+  static constexpr uint32_t kMaxTypeDepth = 256;
+  std::vector<const Type*> laying_out_;  // STRUCTs whose members are being laid out
+  bool pou_depth_reported_ = false;
+  static constexpr size_t kMaxPouDepth = 128;  // while compiling late units: Main.x names an instance variable
 };
 
 std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r, std::string* err);

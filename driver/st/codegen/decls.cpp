@@ -151,6 +151,23 @@ const Type* Compiler::named_type(const Ident& name, uint32_t file, bool report) 
 }
 
 const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const std::string& name_hint) {
+  // Named types are resolved on demand, so a STRUCT holding a STRUCT holding ... recurses
+  // once per level; the parser's limit covers only types written inside one another.
+  struct Depth {
+    explicit Depth(uint32_t& d) : d_(d) { ++d_; }
+    ~Depth() { --d_; }
+    Depth(const Depth&) = delete;
+    Depth& operator=(const Depth&) = delete;
+    uint32_t& d_;
+  } depth(type_depth_);
+  if (type_depth_ > kMaxTypeDepth) {
+    if (!type_depth_reported_) {
+      type_depth_reported_ = true;
+      diags_.error("ST117", spec.loc, "types nested too deep (more than " + std::to_string(kMaxTypeDepth) +
+                                          " levels of types holding other types)");
+    }
+    return nullptr;
+  }
   uint32_t saved = file_;
   file_ = file;
   const Type* result = nullptr;
@@ -223,7 +240,9 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
         auto it = types_.find(canon(name_hint));
         if (it != types_.end() && !it->second.type) it->second.type = t;
       }
+      laying_out_.push_back(t);
       layout_struct(t, spec.members, file);
+      laying_out_.pop_back();
       result = t;
       break;
     }
@@ -262,9 +281,13 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
         diags_.error("ST229", spec.loc, "a subrange needs an integer base type, not " + base->name);
         break;
       }
-      auto lo = spec.sub_lo ? const_int(*spec.sub_lo, file) : std::nullopt;
-      auto hi = spec.sub_hi ? const_int(*spec.sub_hi, file) : std::nullopt;
-      if (!lo || !hi) break;
+      auto lo_opt = spec.sub_lo ? const_int(*spec.sub_lo, file) : std::nullopt;
+      auto hi_opt = spec.sub_hi ? const_int(*spec.sub_hi, file) : std::nullopt;
+      if (!lo_opt || !hi_opt) break;
+      // Plain values: GCC 12 misreads the optionals as maybe uninitialized here.
+      const int64_t lo_v = lo_opt.value_or(0), hi_v = hi_opt.value_or(0);
+      const int64_t* lo = &lo_v;
+      const int64_t* hi = &hi_v;
       if (*hi < *lo) {
         diags_.error("ST229", spec.loc, "empty subrange " + std::to_string(*lo) + ".." + std::to_string(*hi));
         break;
@@ -304,6 +327,16 @@ void Compiler::layout_struct(Type* t, const std::vector<VarDecl>& members, uint3
   for (const auto& d : members) {
     const Type* ft = d.type ? resolve_type(*d.type, file) : nullptr;
     if (!ft) continue;
+    // A member of a STRUCT still being laid out (itself, or one that holds this one), or an
+    // array of it, would make the STRUCT infinitely large; only a REF_TO may point back.
+    const Type* held = ft;
+    while (held->kind == TypeKind::Array && held->elem) held = held->elem;
+    if (held->kind == TypeKind::Struct && std::find(laying_out_.begin(), laying_out_.end(), held) != laying_out_.end()) {
+      diags_.error("ST201", d.type->loc, "STRUCT '" + t->name + "' contains " +
+                                             (held == t ? std::string("itself") : "'" + held->name + "', which contains it") +
+                                             " (use REF_TO for a link back)");
+      continue;
+    }
     for (const auto& n : d.names) {
       if (t->field(n.text)) {
         diags_.error("ST202", n.loc, "member '" + n.text + "' is declared twice");
@@ -339,6 +372,23 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
     if (report) diags_.error("ST215", e.loc, msg);
     return std::nullopt;
   };
+  // Constants defined through constants (C0 := C1 + 1, C1 := C2 + 1, ...) recurse once per
+  // link, and a cycle would never end: both stop at a fixed depth.
+  struct Depth {
+    explicit Depth(uint32_t& d) : d_(d) { ++d_; }
+    ~Depth() { --d_; }
+    Depth(const Depth&) = delete;
+    Depth& operator=(const Depth&) = delete;
+    uint32_t& d_;
+  } depth(const_depth_);
+  if (const_depth_ > kMaxConstDepth) {
+    if (report && !const_depth_reported_) {
+      const_depth_reported_ = true;
+      diags_.error("ST117", e.loc, "constant defined through more than " + std::to_string(kMaxConstDepth) +
+                                       " levels of other constants, or through itself");
+    }
+    return std::nullopt;
+  }
   switch (e.kind) {
     case ExprKind::Literal: {
       const auto& l = static_cast<const LiteralExpr&>(e);
@@ -429,15 +479,27 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
       return c;
     }
     case ExprKind::Binary: {
-      const auto& b = static_cast<const BinaryExpr&>(e);
-      auto l = const_eval(*b.lhs, file, report);
-      auto r = const_eval(*b.rhs, file, report);
-      if (!l || !r) return std::nullopt;
-      std::string why;
-      auto c = fold_binary(b.op, *l, *r, &why);
-      if (!c && report) diags_.error(why.find("zero") != std::string::npos ? "ST217" : "ST215",
-                                     why.find("zero") != std::string::npos ? b.rhs->loc : e.loc, why);
-      return c;
+      // A left-associative chain is folded in a loop along its left spine (see binary()).
+      std::vector<const BinaryExpr*> spine{static_cast<const BinaryExpr*>(&e)};
+      while (spine.back()->lhs->kind == ExprKind::Binary) spine.push_back(static_cast<const BinaryExpr*>(spine.back()->lhs.get()));
+      auto l = const_eval(*spine.back()->lhs, file, report);
+      bool ok = l.has_value();
+      for (size_t k = spine.size(); k-- > 0;) {
+        const BinaryExpr& b = *spine[k];
+        auto r = const_eval(*b.rhs, file, report);
+        if (!ok || !r) {
+          ok = false;
+          continue;  // still check the other operands
+        }
+        std::string why;
+        l = fold_binary(b.op, *l, *r, &why);
+        if (!l) {
+          if (report) diags_.error(why.find("zero") != std::string::npos ? "ST217" : "ST215",
+                                   why.find("zero") != std::string::npos ? b.rhs->loc : b.loc, why);
+          ok = false;
+        }
+      }
+      return ok ? l : std::nullopt;
     }
     default: return fail("a constant expression is required here");
   }
@@ -843,6 +905,16 @@ void Compiler::ensure_layout(PouInfo* p, SourceLoc use) { ensure_compiled(p, use
 
 void Compiler::ensure_compiled(PouInfo* p, SourceLoc use) {
   if (p->compiled) return;
+  // POUs are compiled when first needed (an instance's size, a function's frame), which
+  // recurses once per POU in a chain of instances inside instances.
+  if (compiling_.size() >= kMaxPouDepth) {
+    if (!pou_depth_reported_) {
+      pou_depth_reported_ = true;
+      diags_.error("ST117", use, "'" + p->name + "' is used more than " + std::to_string(kMaxPouDepth) +
+                                     " levels deep (instances inside instances, or calls through calls)");
+    }
+    return;
+  }
   if (std::find(compiling_.begin(), compiling_.end(), p) != compiling_.end()) {
     std::string chain;
     for (auto* c : compiling_) chain += c->name + " -> ";
@@ -855,15 +927,18 @@ void Compiler::ensure_compiled(PouInfo* p, SourceLoc use) {
 }
 
 bool Compiler::implements(const PouInfo* fb, const PouInfo* itf) const {
-  std::function<bool(const PouInfo*)> itf_matches = [&](const PouInfo* i) {
+  // Iterative over the interfaces' EXTENDS graph (cycles were cut when linking).
+  std::vector<const PouInfo*> todo;
+  for (const PouInfo* f = fb; f; f = f->base) todo.insert(todo.end(), f->interfaces.begin(), f->interfaces.end());
+  std::vector<const PouInfo*> seen;
+  while (!todo.empty()) {
+    const PouInfo* i = todo.back();
+    todo.pop_back();
     if (i == itf) return true;
-    for (const auto* e : i->interfaces)
-      if (itf_matches(e)) return true;
-    return false;
-  };
-  for (const PouInfo* f = fb; f; f = f->base)
-    for (const auto* i : f->interfaces)
-      if (itf_matches(i)) return true;
+    if (std::find(seen.begin(), seen.end(), i) != seen.end()) continue;
+    seen.push_back(i);
+    todo.insert(todo.end(), i->interfaces.begin(), i->interfaces.end());
+  }
   return fb == itf;
 }
 
