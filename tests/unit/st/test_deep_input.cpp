@@ -188,5 +188,23 @@ TEST(DeepInput, StructContainingItself) {
   EXPECT_EQ("ok", first_error("TYPE S : STRUCT v : INT; next : REF_TO S; END_STRUCT; END_TYPE\n" + program("s : S;", "s.v := 1;")));
 }
 
+// ------------------------------------------------------------------ wide input
+
+TEST(WideInput, VarBlockOfFortyThousandVariables) {
+  std::string vars;
+  for (int i = 0; i < 40000; ++i) vars += "v" + std::to_string(i) + " : DINT := " + std::to_string(i) + ";\n";
+  EXPECT_EQ(39999 + 1, run_and_read(program(vars, "v0 := v39999 + 1;"), "v0"));
+  // Duplicates are still found, whatever the case.
+  EXPECT_EQ("ST202:40003", first_error(program(vars + "V20000 : INT;", "")));
+}
+
+TEST(WideInput, StructOfFortyThousandMembers) {
+  std::string members;
+  for (int i = 0; i < 40000; ++i) members += "m" + std::to_string(i) + " : INT;\n";
+  std::string type = "TYPE S : STRUCT\n" + members + "END_STRUCT; END_TYPE\n";
+  EXPECT_EQ(7, run_and_read(type + program("s : S; x : DINT;", "s.m39999 := 7; x := s.m39999;"), "x"));
+  EXPECT_EQ("ST202:40002", first_error("TYPE S : STRUCT\n" + members + "M7 : INT;\nEND_STRUCT; END_TYPE\n" + program("s : S;", "")));
+}
+
 }  // namespace
 }  // namespace plcfi::st
