@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "codegen/compiler.hpp"
@@ -289,6 +290,8 @@ class Compiler {
   bool const_depth_reported_ = false;  // each depth error once per compilation: every
                                       // declaration along a long chain would hit it again
   static constexpr uint32_t kMaxConstDepth = 512;
+  uint32_t const_depth_hits_ = 0;
+  std::unordered_set<const Expr*> too_deep_consts_;  // constant initializers that hit kMaxConstDepth
   uint32_t type_depth_ = 0;  // resolve_type() recursion (named types holding named types)
   bool type_depth_reported_ = false;
   static constexpr uint32_t kMaxTypeDepth = 256;

@@ -385,6 +385,7 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
     uint32_t& d_;
   } depth(const_depth_);
   if (const_depth_ > kMaxConstDepth) {
+    ++const_depth_hits_;
     if (report && !const_depth_reported_) {
       const_depth_reported_ = true;
       diags_.error("ST117", e.loc, "constant defined through more than " + std::to_string(kMaxConstDepth) +
@@ -432,8 +433,18 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
       std::string key = canon(n.name.text);
       const Symbol* s = lookup(key);
       if (s && s->kind == SymKind::EnumValue) return ConstV{ConstV::K::Int, s->enum_value, 0, {}};
+      // A constant found too deep is remembered: a chain of 10,000 constants would
+      // otherwise be followed 512 links deep again from each of its links. (Values are
+      // not kept: a name in an initializer resolves where it is evaluated.)
+      auto init_value = [&](const Expr& init, uint32_t f) -> std::optional<ConstV> {
+        if (too_deep_consts_.count(&init)) return std::nullopt;
+        const uint32_t hits = const_depth_hits_;
+        auto c = const_eval(init, f, report);
+        if (!c && const_depth_hits_ != hits) too_deep_consts_.insert(&init);
+        return c;
+      };
       if (s && s->kind == SymKind::Var && s->constant && s->decl && s->decl->init) {
-        auto c = const_eval(*s->decl->init, file, report);
+        auto c = init_value(*s->decl->init, file);
         if (c && s->type && s->type->is_real() && c->k == ConstV::K::Int) {
           c->k = ConstV::K::Real;
           c->r = static_cast<double>(c->i);
@@ -451,10 +462,10 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
         if (decl_pou_)
           for (const VarBlock* blk : decl_pou_->blocks)
             for (const auto& d : blk->decls)
-              if (const Expr* init = const_init(d)) return const_eval(*init, decl_pou_->file, report);
+              if (const Expr* init = const_init(d)) return init_value(*init, decl_pou_->file);
         auto gc = global_consts_.find(key);
         if (gc != global_consts_.end() && const_init(*gc->second.first))
-          return const_eval(*const_init(*gc->second.first), gc->second.second, report);
+          return init_value(*const_init(*gc->second.first), gc->second.second);
       }
       if (!s) {
         auto it = enum_values_.find(key);
