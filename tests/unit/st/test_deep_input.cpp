@@ -121,6 +121,21 @@ TEST(DeepInput, FunctionBlocksNestedTenThousandDeep) {
   EXPECT_EQ("ST117", first_error(src).substr(0, 5));
 }
 
+TEST(DeepInput, FunctionsCallingFunctionsTenThousandDeep) {
+  // Each FUNCTION is compiled when its caller needs its frame: a call chain nests the
+  // compiler as deep as it is long.
+  auto chain = [](int n) {
+    std::string src;
+    for (int i = 0; i < n; ++i)
+      src += "FUNCTION F" + std::to_string(i) + " : DINT\nVAR_INPUT a : DINT; END_VAR\nF" + std::to_string(i) + " := F" +
+             std::to_string(i + 1) + "(a := a + 1);\nEND_FUNCTION\n";
+    src += "FUNCTION F" + std::to_string(n) + " : DINT\nVAR_INPUT a : DINT; END_VAR\nF" + std::to_string(n) + " := a;\nEND_FUNCTION\n";
+    return src + program("x : DINT;", "x := F0(a := 0);");
+  };
+  EXPECT_EQ(100, run_and_read(chain(100), "x"));
+  EXPECT_EQ("ST117", first_error(chain(kTerms)).substr(0, 5));
+}
+
 TEST(DeepInput, StructsNestedTwentyThousandDeep) {
   const int n = 2 * kTerms;
   std::string src = "TYPE\n";
