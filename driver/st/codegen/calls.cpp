@@ -99,6 +99,54 @@ Val Compiler::native_list(Native n, const Type* result, const std::vector<Slot>&
   return v;
 }
 
+// Whether evaluating e may run a call (a function, a method, a property getter), which
+// could change variables or take the method stack's top. Conservative: only literals,
+// variables, fields of a named structure or instance, and operators over them are known
+// to run none. Iterative, so that a long operator chain costs no stack.
+bool Compiler::may_call(const Expr& root) const {
+  std::vector<const Expr*> todo{&root};
+  while (!todo.empty()) {
+    const Expr* e = todo.back();
+    todo.pop_back();
+    switch (e->kind) {
+      case ExprKind::Literal:
+      case ExprKind::EnumLiteral:
+      case ExprKind::DirectAddr:
+      case ExprKind::This:
+        break;
+      case ExprKind::Name: {
+        const Symbol* s = lookup(canon(static_cast<const NameExpr&>(*e).name.text));
+        if (!s) return true;  // a property of this instance, read by its bare name
+        break;
+      }
+      case ExprKind::Member: {
+        const auto& m = static_cast<const MemberExpr&>(*e);
+        if (m.base->kind != ExprKind::Name) return true;
+        const Symbol* s = lookup(canon(static_cast<const NameExpr&>(*m.base).name.text));
+        if (!s || s->kind != SymKind::Var || !s->type) return true;
+        if (s->type->kind != TypeKind::Struct && s->type->kind != TypeKind::Pou) return true;
+        if (!s->type->field(m.member.text)) return true;
+        break;
+      }
+      case ExprKind::BitAccess: todo.push_back(static_cast<const BitAccessExpr&>(*e).base.get()); break;
+      case ExprKind::Deref: todo.push_back(static_cast<const DerefExpr&>(*e).base.get()); break;
+      case ExprKind::Unary: todo.push_back(static_cast<const UnaryExpr&>(*e).operand.get()); break;
+      case ExprKind::Binary:
+        todo.push_back(static_cast<const BinaryExpr&>(*e).lhs.get());
+        todo.push_back(static_cast<const BinaryExpr&>(*e).rhs.get());
+        break;
+      case ExprKind::Index: {
+        const auto& ix = static_cast<const IndexExpr&>(*e);
+        todo.push_back(ix.base.get());
+        for (const auto& i : ix.indices) todo.push_back(i.get());
+        break;
+      }
+      default: return true;
+    }
+  }
+  return false;
+}
+
 // ------------------------------------------------------------------ dispatch
 
 Val Compiler::call(const CallExpr& c, bool as_statement) {
@@ -383,20 +431,38 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
       diags_.error("ST213", c.loc, "cannot call this instance");
       return bad();
   }
+  // Every output is read before any destination is evaluated: a call in a destination
+  // (arr[f()]) may run this instance again, and what the caller captures is what this
+  // call produced.
+  bool dst_calls = std::any_of(outs.begin(), outs.end(), [&](const auto& o) { return o.second->value && may_call(*o.second->value); });
+  std::vector<Val> out_vals;
   for (auto [p, a] : outs) {
-    if (!a->value) continue;
+    if (!a->value) {
+      out_vals.emplace_back();
+      continue;
+    }
     ++p->reads;
     Place field = inst;
     field.type = p->type;
     field.off = inst.off + p->offset;
-    Place dst = place(*a->value, true);
     Val v = load(field);
+    if (dst_calls && v.slot.kind == SK::Var) {
+      Slot copy = p->type->is_string() ? temp(p->type->size, 1) : temp_for(p->type);
+      store(frame_place(copy, p->type), v.slot);
+      v.slot = copy;
+    }
+    out_vals.push_back(v);
+  }
+  for (size_t k = 0; k < outs.size(); ++k) {
+    const CallArg* a = outs[k].second;
+    if (!a->value) continue;
+    Val v = out_vals[k];
     if (a->negate) {
       Slot t = temp(1, 1);
       emit(Op::BNOT, {t, v.slot});
       v.slot = t;
     }
-    assign(dst, v, a->loc);
+    assign(place(*a->value, true), v, a->loc);
   }
   return none;
 }
@@ -422,16 +488,20 @@ void Compiler::declare_pou(PouInfo* p) {
   file_ = saved;
 }
 
+// Arguments are evaluated before the method's frame is taken. FRAME names the method
+// stack's top, and a call in an argument (a method, a property getter, a function whose
+// body calls one) takes its frame at that same top: a frame taken first would have the
+// arguments stored so far overwritten by the nested call. Outputs and the result are read
+// from the frame right after the call, before any destination is evaluated, for the same
+// reason.
 Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt) {
   declare_pou(m);
   (void)inst;
-  Slot frame = temp(4, 4);
-  emit(Op::FRAME, {frame});
-  if (!virt) emit(Op::STI4, {frame, 8u, this_ptr});
   std::vector<Symbol*> params = m->inputs;
   params.insert(params.end(), m->inouts.begin(), m->inouts.end());
   std::vector<const CallArg*> bound(params.size(), nullptr);
   std::vector<std::pair<Symbol*, const CallArg*>> outs;
+  std::vector<size_t> order;  // bound parameters in the order their arguments are written
   size_t pos = 0;
   for (const auto& a : c.args) {
     size_t idx = SIZE_MAX;
@@ -453,7 +523,51 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
       }
     }
     bound[idx] = &a;
+    order.push_back(idx);
   }
+  // A value read from a variable is copied when a later argument may run a call (which
+  // could change that variable), so that each argument is read in its turn, as a
+  // FUNCTION's are.
+  std::vector<bool> call_after(order.size(), false);
+  for (size_t k = order.size(); k-- > 1;)
+    call_after[k - 1] = call_after[k] || (bound[order[k]]->value && may_call(*bound[order[k]]->value));
+  struct Staged {
+    Val v;
+    bool direct = true;  // v still to be coerced into the field; else v.slot holds the field's value
+    bool ok = false;
+  };
+  std::vector<Staged> staged(params.size());
+  for (size_t k = 0; k < order.size(); ++k) {
+    size_t i = order[k];
+    Symbol* p = params[i];
+    const CallArg* a = bound[i];
+    if (!a->value) continue;
+    Staged& st = staged[i];
+    if (p->where == Where::InOut) {
+      Place src = place(*a->value, true);
+      if (!src.ok) continue;
+      st.v.type = elem(TypeKind::UDInt);
+      st.v.slot = addr_of(src, a->loc);
+    } else {
+      st.v = expr_for(*a->value, p->type);
+      if (!st.v.ok) continue;
+    }
+    st.ok = true;
+    bool from_variable = !st.v.is_const && (st.v.slot.kind == SK::Var || st.v.slot.kind == SK::Hidden);
+    if (from_variable && call_after[k]) {
+      const Type* t = p->where == Where::InOut ? elem(TypeKind::UDInt) : p->type;
+      Slot copy = t->is_string() ? temp(t->size, 1) : temp_for(t);
+      Place dst = frame_place(copy, t);
+      assign(dst, st.v, a->loc);
+      st.v.type = t;
+      st.v.is_const = false;
+      st.v.slot = copy;
+      st.direct = false;
+    }
+  }
+  Slot frame = temp(4, 4);
+  emit(Op::FRAME, {frame});
+  if (!virt) emit(Op::STI4, {frame, 8u, this_ptr});
   // Every input is written: given ones from the call, the others from their defaults
   // (a method's frame is fresh on each call).
   for (size_t i = 0; i < params.size(); ++i) {
@@ -468,13 +582,13 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
         diags_.error("ST224", c.loc, "VAR_IN_OUT '" + p->name + "' of method " + m->name + " must be passed");
         continue;
       }
-      Place src = place(*bound[i]->value, true);
-      if (!src.ok) continue;
-      store(field, addr_of(src, bound[i]->loc));
+      if (staged[i].ok) store(field, staged[i].v.slot);
       continue;
     }
     if (bound[i] && bound[i]->value) {
-      assign(field, expr_for(*bound[i]->value, p->type), bound[i]->loc);
+      if (!staged[i].ok) continue;
+      if (staged[i].direct) assign(field, staged[i].v, bound[i]->loc);
+      else store(field, staged[i].v.slot);
     } else {
       std::vector<uint8_t> img(p->type->size);
       write_init(img, 0, p->type, p->decl ? p->decl->init.get() : nullptr, m->file);
@@ -484,25 +598,29 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
   mark(c.loc);
   if (virt) emit(Op::CALLV, {frame, this_ptr, m->selector});
   else emit(Op::CALLS, {frame, Arg::entry(m)});
-  for (auto [o, a] : outs) {
-    if (!a->value) continue;
-    Place src;
-    src.k = Place::K::Ind;
-    src.ptr = frame;
-    src.off = o->offset;
-    src.type = o->type;
-    Val v = load(src);
-    assign(place(*a->value, true), v, a->loc);
-  }
+  auto frame_field = [&](uint32_t off, const Type* t) {
+    Place f;
+    f.k = Place::K::Ind;
+    f.ptr = frame;
+    f.off = off;
+    f.type = t;
+    return f;
+  };
   Val r;
   r.type = m->result;
-  if (m->result && m->result->kind != TypeKind::Void) {
-    Place res;
-    res.k = Place::K::Ind;
-    res.ptr = frame;
-    res.off = m->result_offset;
-    res.type = m->result;
-    r = load(res);
+  if (m->result && m->result->kind != TypeKind::Void) r = load(frame_field(m->result_offset, m->result));
+  std::vector<Val> out_vals;
+  for (auto [o, a] : outs) out_vals.push_back(a->value ? load(frame_field(o->offset, o->type)) : Val{});
+  for (size_t k = 0; k < outs.size(); ++k) {
+    const CallArg* a = outs[k].second;
+    if (!a->value) continue;
+    Val v = out_vals[k];
+    if (a->negate) {
+      Slot t = temp(1, 1);
+      emit(Op::BNOT, {t, v.slot});
+      v.slot = t;
+    }
+    assign(place(*a->value, true), v, a->loc);
   }
   return r;
 }

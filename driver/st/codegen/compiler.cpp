@@ -551,6 +551,28 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
       }
   }
 
+  // An interface extending itself (directly or through others) has its EXTENDS cut, so
+  // that every later walk of the graph ends.
+  for (const auto& p : app_->pous) {
+    if (p->kind != PouKind::Interface) continue;
+    std::vector<const PouInfo*> todo(p->interfaces.begin(), p->interfaces.end()), seen;
+    bool cycle = false;
+    while (!todo.empty() && !cycle) {
+      const PouInfo* i = todo.back();
+      todo.pop_back();
+      if (i == p.get()) cycle = true;
+      if (std::find(seen.begin(), seen.end(), i) != seen.end()) continue;
+      seen.push_back(i);
+      todo.insert(todo.end(), i->interfaces.begin(), i->interfaces.end());
+    }
+    if (cycle) {
+      const Pou& d = *p->decl;
+      SourceLoc at = d.extends ? d.extends->loc : !d.implements.empty() ? d.implements[0].loc : d.name.loc;
+      diags_.error("ST226", at, "interface '" + p->name + "' extends itself");
+      p->interfaces.clear();
+    }
+  }
+
   // Global constants are known by name before any declaration needs them (array bounds).
   for (const auto* u : all) {
     auto note = [&](const std::vector<VarBlock>& blocks) {
@@ -588,7 +610,10 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   // Interface conformance: every method of every implemented interface must exist.
   for (const auto& p : app_->pous) {
     if (p->kind != PouKind::FunctionBlock || p->decl->is_abstract) continue;
+    std::vector<const PouInfo*> checked;
     std::function<void(const PouInfo*)> check = [&](const PouInfo* itf) {
+      if (std::find(checked.begin(), checked.end(), itf) != checked.end()) return;
+      checked.push_back(itf);
       for (const auto& m : itf->methods) {
         PouInfo* impl = nullptr;
         for (PouInfo* f = p.get(); f && !impl; f = f->base)

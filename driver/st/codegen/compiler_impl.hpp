@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "codegen/compiler.hpp"
@@ -238,6 +239,7 @@ class Compiler {
 
   // ---- calls (calls.cpp)
   Val call(const CallExpr& c, bool as_statement);
+  bool may_call(const Expr& e) const;
   Val call_function(PouInfo* f, const CallExpr& c);
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
@@ -283,7 +285,19 @@ class Compiler {
   std::vector<std::unique_ptr<PouInfo>> test_pous_;
   std::vector<std::unique_ptr<Pou>> synthetic_;
   uint32_t next_type_id_ = 1;
-  bool instance_paths_ = false;  // while compiling late units: Main.x names an instance variable
+  bool instance_paths_ = false;
+  uint32_t const_depth_ = 0;  // const_eval() recursion (constants defined through constants)
+  bool const_depth_reported_ = false;  // each depth error once per compilation: every
+                                      // declaration along a long chain would hit it again
+  static constexpr uint32_t kMaxConstDepth = 512;
+  uint32_t const_depth_hits_ = 0;
+  std::unordered_set<const Expr*> too_deep_consts_;  // constant initializers that hit kMaxConstDepth
+  uint32_t type_depth_ = 0;  // resolve_type() recursion (named types holding named types)
+  bool type_depth_reported_ = false;
+  static constexpr uint32_t kMaxTypeDepth = 256;
+  std::vector<const Type*> laying_out_;  // STRUCTs whose members are being laid out
+  bool pou_depth_reported_ = false;
+  static constexpr size_t kMaxPouDepth = 128;  // while compiling late units: Main.x names an instance variable
 };
 
 std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r, std::string* err);

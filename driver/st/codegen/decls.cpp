@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <unordered_set>
 
 #include "compiler_impl.hpp"
 #include "vm/memory.hpp"
@@ -151,6 +152,23 @@ const Type* Compiler::named_type(const Ident& name, uint32_t file, bool report) 
 }
 
 const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const std::string& name_hint) {
+  // Named types are resolved on demand, so a STRUCT holding a STRUCT holding ... recurses
+  // once per level; the parser's limit covers only types written inside one another.
+  struct Depth {
+    explicit Depth(uint32_t& d) : d_(d) { ++d_; }
+    ~Depth() { --d_; }
+    Depth(const Depth&) = delete;
+    Depth& operator=(const Depth&) = delete;
+    uint32_t& d_;
+  } depth(type_depth_);
+  if (type_depth_ > kMaxTypeDepth) {
+    if (!type_depth_reported_) {
+      type_depth_reported_ = true;
+      diags_.error("ST117", spec.loc, "types nested too deep (more than " + std::to_string(kMaxTypeDepth) +
+                                          " levels of types holding other types)");
+    }
+    return nullptr;
+  }
   uint32_t saved = file_;
   file_ = file;
   const Type* result = nullptr;
@@ -223,7 +241,9 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
         auto it = types_.find(canon(name_hint));
         if (it != types_.end() && !it->second.type) it->second.type = t;
       }
+      laying_out_.push_back(t);
       layout_struct(t, spec.members, file);
+      laying_out_.pop_back();
       result = t;
       break;
     }
@@ -262,9 +282,13 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
         diags_.error("ST229", spec.loc, "a subrange needs an integer base type, not " + base->name);
         break;
       }
-      auto lo = spec.sub_lo ? const_int(*spec.sub_lo, file) : std::nullopt;
-      auto hi = spec.sub_hi ? const_int(*spec.sub_hi, file) : std::nullopt;
-      if (!lo || !hi) break;
+      auto lo_opt = spec.sub_lo ? const_int(*spec.sub_lo, file) : std::nullopt;
+      auto hi_opt = spec.sub_hi ? const_int(*spec.sub_hi, file) : std::nullopt;
+      if (!lo_opt || !hi_opt) break;
+      // Plain values: GCC 12 misreads the optionals as maybe uninitialized here.
+      const int64_t lo_v = lo_opt.value_or(0), hi_v = hi_opt.value_or(0);
+      const int64_t* lo = &lo_v;
+      const int64_t* hi = &hi_v;
       if (*hi < *lo) {
         diags_.error("ST229", spec.loc, "empty subrange " + std::to_string(*lo) + ".." + std::to_string(*hi));
         break;
@@ -301,11 +325,23 @@ void Compiler::layout_struct(Type* t, const std::vector<VarDecl>& members, uint3
     const Expr* init;
   };
   std::vector<Pending> inits;
+  std::unordered_set<std::string> names;  // canonical member names (a linear search was quadratic)
+  for (const auto& f : t->fields) names.insert(canon(f.name));
   for (const auto& d : members) {
     const Type* ft = d.type ? resolve_type(*d.type, file) : nullptr;
     if (!ft) continue;
+    // A member of a STRUCT still being laid out (itself, or one that holds this one), or an
+    // array of it, would make the STRUCT infinitely large; only a REF_TO may point back.
+    const Type* held = ft;
+    while (held->kind == TypeKind::Array && held->elem) held = held->elem;
+    if (held->kind == TypeKind::Struct && std::find(laying_out_.begin(), laying_out_.end(), held) != laying_out_.end()) {
+      diags_.error("ST201", d.type->loc, "STRUCT '" + t->name + "' contains " +
+                                             (held == t ? std::string("itself") : "'" + held->name + "', which contains it") +
+                                             " (use REF_TO for a link back)");
+      continue;
+    }
     for (const auto& n : d.names) {
-      if (t->field(n.text)) {
+      if (!names.insert(canon(n.text)).second) {
         diags_.error("ST202", n.loc, "member '" + n.text + "' is declared twice");
         continue;
       }
@@ -339,6 +375,24 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
     if (report) diags_.error("ST215", e.loc, msg);
     return std::nullopt;
   };
+  // Constants defined through constants (C0 := C1 + 1, C1 := C2 + 1, ...) recurse once per
+  // link, and a cycle would never end: both stop at a fixed depth.
+  struct Depth {
+    explicit Depth(uint32_t& d) : d_(d) { ++d_; }
+    ~Depth() { --d_; }
+    Depth(const Depth&) = delete;
+    Depth& operator=(const Depth&) = delete;
+    uint32_t& d_;
+  } depth(const_depth_);
+  if (const_depth_ > kMaxConstDepth) {
+    ++const_depth_hits_;
+    if (report && !const_depth_reported_) {
+      const_depth_reported_ = true;
+      diags_.error("ST117", e.loc, "constant defined through more than " + std::to_string(kMaxConstDepth) +
+                                       " levels of other constants, or through itself");
+    }
+    return std::nullopt;
+  }
   switch (e.kind) {
     case ExprKind::Literal: {
       const auto& l = static_cast<const LiteralExpr&>(e);
@@ -379,8 +433,18 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
       std::string key = canon(n.name.text);
       const Symbol* s = lookup(key);
       if (s && s->kind == SymKind::EnumValue) return ConstV{ConstV::K::Int, s->enum_value, 0, {}};
+      // A constant found too deep is remembered: a chain of 10,000 constants would
+      // otherwise be followed 512 links deep again from each of its links. (Values are
+      // not kept: a name in an initializer resolves where it is evaluated.)
+      auto init_value = [&](const Expr& init, uint32_t f) -> std::optional<ConstV> {
+        if (too_deep_consts_.count(&init)) return std::nullopt;
+        const uint32_t hits = const_depth_hits_;
+        auto c = const_eval(init, f, report);
+        if (!c && const_depth_hits_ != hits) too_deep_consts_.insert(&init);
+        return c;
+      };
       if (s && s->kind == SymKind::Var && s->constant && s->decl && s->decl->init) {
-        auto c = const_eval(*s->decl->init, file, report);
+        auto c = init_value(*s->decl->init, file);
         if (c && s->type && s->type->is_real() && c->k == ConstV::K::Int) {
           c->k = ConstV::K::Real;
           c->r = static_cast<double>(c->i);
@@ -398,10 +462,10 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
         if (decl_pou_)
           for (const VarBlock* blk : decl_pou_->blocks)
             for (const auto& d : blk->decls)
-              if (const Expr* init = const_init(d)) return const_eval(*init, decl_pou_->file, report);
+              if (const Expr* init = const_init(d)) return init_value(*init, decl_pou_->file);
         auto gc = global_consts_.find(key);
         if (gc != global_consts_.end() && const_init(*gc->second.first))
-          return const_eval(*const_init(*gc->second.first), gc->second.second, report);
+          return init_value(*const_init(*gc->second.first), gc->second.second);
       }
       if (!s) {
         auto it = enum_values_.find(key);
@@ -429,15 +493,27 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
       return c;
     }
     case ExprKind::Binary: {
-      const auto& b = static_cast<const BinaryExpr&>(e);
-      auto l = const_eval(*b.lhs, file, report);
-      auto r = const_eval(*b.rhs, file, report);
-      if (!l || !r) return std::nullopt;
-      std::string why;
-      auto c = fold_binary(b.op, *l, *r, &why);
-      if (!c && report) diags_.error(why.find("zero") != std::string::npos ? "ST217" : "ST215",
-                                     why.find("zero") != std::string::npos ? b.rhs->loc : e.loc, why);
-      return c;
+      // A left-associative chain is folded in a loop along its left spine (see binary()).
+      std::vector<const BinaryExpr*> spine{static_cast<const BinaryExpr*>(&e)};
+      while (spine.back()->lhs->kind == ExprKind::Binary) spine.push_back(static_cast<const BinaryExpr*>(spine.back()->lhs.get()));
+      auto l = const_eval(*spine.back()->lhs, file, report);
+      bool ok = l.has_value();
+      for (size_t k = spine.size(); k-- > 0;) {
+        const BinaryExpr& b = *spine[k];
+        auto r = const_eval(*b.rhs, file, report);
+        if (!ok || !r) {
+          ok = false;
+          continue;  // still check the other operands
+        }
+        std::string why;
+        l = fold_binary(b.op, *l, *r, &why);
+        if (!l) {
+          if (report) diags_.error(why.find("zero") != std::string::npos ? "ST217" : "ST215",
+                                   why.find("zero") != std::string::npos ? b.rhs->loc : b.loc, why);
+          ok = false;
+        }
+      }
+      return ok ? l : std::nullopt;
     }
     default: return fail("a constant expression is required here");
   }
@@ -701,13 +777,20 @@ void Compiler::declare_vars(PouInfo* p) {
   uint32_t off = 8;
   if (p->kind == PouKind::Method) off = 12;  // [8..12): THIS
   if (p->base) off = align_up(p->base->frame_size, 8);
+  // Names declared so far, canonical: a search of p->vars per declaration made a block of
+  // 40,000 variables quadratic (6.6 s to check).
+  std::unordered_set<std::string> declared;
+  for (const auto& v : p->vars) declared.insert(canon(v->name));
+  std::unordered_set<std::string> inherited;
+  if (p->base && p->base->type)
+    for (const auto& f : p->base->type->fields) inherited.insert(canon(f.name));
   auto add = [&](const VarDecl& d, const Ident& n, const Type* t) -> Symbol* {
-    for (const auto& v : p->vars)
-      if (iequals(v->name, n.text)) {
-        diags_.error("ST202", n.loc, "'" + n.text + "' is declared twice in " + p->name);
-        return nullptr;
-      }
-    if (p->base && p->base->type && p->base->type->field(n.text)) {
+    std::string key = canon(n.text);
+    if (declared.count(key)) {
+      diags_.error("ST202", n.loc, "'" + n.text + "' is declared twice in " + p->name);
+      return nullptr;
+    }
+    if (inherited.count(key)) {
       diags_.error("ST202", n.loc, "'" + n.text + "' is already declared in the base FB " + p->base->name);
       return nullptr;
     }
@@ -721,6 +804,7 @@ void Compiler::declare_vars(PouInfo* p) {
     s->loc = n.loc;
     Symbol* raw = s.get();
     p->vars.push_back(std::move(s));
+    declared.insert(std::move(key));
     return raw;
   };
   auto place_var = [&](Symbol* s, uint32_t size, uint32_t align) {
@@ -843,6 +927,16 @@ void Compiler::ensure_layout(PouInfo* p, SourceLoc use) { ensure_compiled(p, use
 
 void Compiler::ensure_compiled(PouInfo* p, SourceLoc use) {
   if (p->compiled) return;
+  // POUs are compiled when first needed (an instance's size, a function's frame), which
+  // recurses once per POU in a chain of instances inside instances.
+  if (compiling_.size() >= kMaxPouDepth) {
+    if (!pou_depth_reported_) {
+      pou_depth_reported_ = true;
+      diags_.error("ST117", use, "'" + p->name + "' is used more than " + std::to_string(kMaxPouDepth) +
+                                     " levels deep (instances inside instances, or calls through calls)");
+    }
+    return;
+  }
   if (std::find(compiling_.begin(), compiling_.end(), p) != compiling_.end()) {
     std::string chain;
     for (auto* c : compiling_) chain += c->name + " -> ";
@@ -855,15 +949,18 @@ void Compiler::ensure_compiled(PouInfo* p, SourceLoc use) {
 }
 
 bool Compiler::implements(const PouInfo* fb, const PouInfo* itf) const {
-  std::function<bool(const PouInfo*)> itf_matches = [&](const PouInfo* i) {
+  // Iterative over the interfaces' EXTENDS graph (cycles were cut when linking).
+  std::vector<const PouInfo*> todo;
+  for (const PouInfo* f = fb; f; f = f->base) todo.insert(todo.end(), f->interfaces.begin(), f->interfaces.end());
+  std::vector<const PouInfo*> seen;
+  while (!todo.empty()) {
+    const PouInfo* i = todo.back();
+    todo.pop_back();
     if (i == itf) return true;
-    for (const auto* e : i->interfaces)
-      if (itf_matches(e)) return true;
-    return false;
-  };
-  for (const PouInfo* f = fb; f; f = f->base)
-    for (const auto* i : f->interfaces)
-      if (itf_matches(i)) return true;
+    if (std::find(seen.begin(), seen.end(), i) != seen.end()) continue;
+    seen.push_back(i);
+    todo.insert(todo.end(), i->interfaces.begin(), i->interfaces.end());
+  }
   return fb == itf;
 }
 

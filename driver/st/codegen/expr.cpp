@@ -1069,12 +1069,28 @@ Val Compiler::unary(const UnaryExpr& u, const Type* expected) {
   return out;
 }
 
+// A left-associative chain (1 + 1 + ... + 1, a AND b AND ...) is a left spine as deep as
+// it is long: it is walked in a loop, so that only true nesting (parentheses, operators of
+// higher precedence on the right) costs stack, and that is bounded by the parser.
 Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
-  Val l = expr(*e.lhs, is_cmp(e.op) ? nullptr : expected);
-  if (!l.ok) return bad();
-  Val r = expr(*e.rhs, l.type && l.type->kind == TypeKind::Enum ? l.type : (is_cmp(e.op) ? nullptr : expected));
-  if (!r.ok) return bad();
-  return combine(e.op, l, r, e.loc);
+  std::vector<const BinaryExpr*> spine{&e};  // top first
+  std::vector<const Type*> want{expected};   // the type each spine node's context expects
+  while (spine.back()->lhs->kind == ExprKind::Binary) {
+    const BinaryExpr* n = spine.back();
+    want.push_back(is_cmp(n->op) ? nullptr : want.back());
+    spine.push_back(static_cast<const BinaryExpr*>(n->lhs.get()));
+  }
+  const BinaryExpr* bottom = spine.back();
+  Val l = expr(*bottom->lhs, is_cmp(bottom->op) ? nullptr : want.back());
+  for (size_t k = spine.size(); k-- > 0;) {
+    const BinaryExpr& n = *spine[k];
+    if (!l.ok) return bad();
+    Val r = expr(*n.rhs, l.type && l.type->kind == TypeKind::Enum ? l.type : (is_cmp(n.op) ? nullptr : want[k]));
+    if (!r.ok) return bad();
+    l = combine(n.op, l, r, n.loc);
+    if (k > 0) const_cast<BinaryExpr&>(n).type = l.type;  // expr() records the top node's
+  }
+  return l;
 }
 
 Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {

@@ -146,6 +146,16 @@ struct UnaryExpr : Expr {
 
 struct BinaryExpr : Expr {
   explicit BinaryExpr(SourceLoc l) : Expr(ExprKind::Binary, l) {}
+  // A chain of 10,000 terms is a left spine 10,000 deep: freed in a loop, not by recursion.
+  ~BinaryExpr() override {
+    ExprPtr next = std::move(lhs);
+    while (next && next->kind == ExprKind::Binary) {
+      ExprPtr below = std::move(static_cast<BinaryExpr&>(*next).lhs);
+      next = std::move(below);
+    }
+  }
+  BinaryExpr(const BinaryExpr&) = delete;
+  BinaryExpr& operator=(const BinaryExpr&) = delete;
   BinaryOp op = BinaryOp::Add;
   ExprPtr lhs, rhs;
 };

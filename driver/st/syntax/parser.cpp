@@ -476,7 +476,17 @@ ExprPtr Parser::parse_power() {
 ExprPtr Parser::parse_postfix() {
   const size_t start = pos_;
   ExprPtr e = parse_primary();
+  // Each suffix nests the expression one level (p^^^ is three dereferences); a chain longer
+  // than any type could nest is an error, and the rest of it is read but not kept, so that
+  // no later stage walks a chain thousands deep.
+  int links = 0;
+  ExprPtr kept;  // the chain up to the limit, while the rest is read into e and dropped
   for (;;) {
+    if (!kept && (at(Tok::Dot) || at(Tok::LBracket) || at(Tok::Caret) || at(Tok::LParen)) && ++links > kMaxDepth) {
+      report_too_deep();
+      kept = error_expr(e->loc);
+    }
+    if (kept) e = error_expr(kept->loc);  // drop the suffix read last
     if (at(Tok::Dot)) {
       advance();
       // Keywords are fine as member names after '.' (fb.METHOD, s.TYPE), except block words,
@@ -501,7 +511,7 @@ ExprPtr Parser::parse_postfix() {
         e = std::move(b);
       } else {
         error("ST133", missing_loc(), "expected a member name or bit number after '.', found " + describe(cur()));
-        return e;
+        return kept ? std::move(kept) : std::move(e);
       }
     } else if (at(Tok::LBracket)) {
       advance();
@@ -524,7 +534,7 @@ ExprPtr Parser::parse_postfix() {
       parse_call_args(call->args, callee);
       e = std::move(call);
     } else {
-      return e;
+      return kept ? std::move(kept) : std::move(e);
     }
   }
 }
