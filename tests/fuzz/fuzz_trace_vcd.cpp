@@ -1,41 +1,7 @@
 // Fuzz target: the VCD trace reader (in memory), its states and the trace program of
-// its columns, as `plcfi edtl check` reads a trace before compiling monitors.
-#include <cstdint>
-#include <string>
-#include <vector>
-
-#include "fuzz_support.hpp"
-#include "monitor/trace_reader.hpp"
-
-namespace {
-
-// States pulled per input: a resampled trace may hold many (#0, then #1000000000 with a
-// 1 ns cycle); the reader is linear in them, the fuzzer needs speed.
-constexpr int kMaxStates = 10'000;
-
-}  // namespace
+// its columns (tests/fuzz/fuzz_trace.hpp).
+#include "fuzz_trace.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  using namespace plcfi;
-  if (size == 0) return 0;
-  // The first byte picks the cycle: 0 (one state per time stamp / no time column) or 1..255 ns.
-  int64_t cycle_ns = data[0];
-  std::string err;
-  auto reader = monitor::TraceReader::from_text("fuzz.vcd", std::string(fuzz::as_text(data + 1, size - 1)),
-                                                monitor::TraceFormat::Vcd, cycle_ns, &err);
-  if (!reader) {
-    if (err.empty()) __builtin_trap();  // a failure always says why
-    return 0;
-  }
-  std::string program;
-  (void)monitor::trace_program(reader->columns(), &program, &err);
-  int64_t t = 0, prev = INT64_MIN;
-  std::vector<double> values;
-  err.clear();
-  for (int n = 0; n < kMaxStates && reader->next(&t, &values, &err); ++n) {
-    // The reader's contract: one value per column, time never going back.
-    if (values.size() != reader->columns().size() || t < prev) __builtin_trap();
-    prev = t;
-  }
-  return 0;
+  return plcfi::fuzz::fuzz_trace(data, size, plcfi::monitor::TraceFormat::Vcd, "fuzz.vcd");
 }
