@@ -306,7 +306,7 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
       Place src = place(*a.value, true);
       if (!src.ok) continue;
       if (!same_type(src.type, p->type) && src.type != p->type) {
-        diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a " + p->type->name + " variable, not " + src.type->name);
+        diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a variable of type " + p->type->name + ", not " + src.type->name);
         continue;
       }
       store(frame_place(frame.plus(p->offset), elem(TypeKind::UDInt)), addr_of(src, a.value->loc));
@@ -401,7 +401,7 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
       Place src = place(*a.value, true);
       if (!src.ok) continue;
       if (!same_type(src.type, p->type) && src.type != p->type) {
-        diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a " + p->type->name + " variable, not " + src.type->name);
+        diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a variable of type " + p->type->name + ", not " + src.type->name);
         continue;
       }
       store(field, addr_of(src, a.value->loc));

@@ -1,6 +1,7 @@
 // Compiler driver: indexing order, POU bodies, code emission, frame finalization,
 // configuration (tasks and program instances), test fixtures and the final link.
 #include <algorithm>
+#include <set>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -633,6 +634,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
 
   // Configuration: tasks and program instances.
   for (const auto* u : units) {
+    std::set<std::string> refused_tasks;  // canonical names of tasks already reported
     for (const auto& c : u->configs) {
       app_->has_configuration = true;
       for (const auto& r : c.resources) {
@@ -640,15 +642,25 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
           TaskInfo ti;
           ti.name = t.name.text;
           ti.loc = t.loc;
-          if (t.single) diags_.error("ST235", t.single->loc, "event tasks (SINGLE) are not supported; use INTERVAL");
+          // A task refused here is remembered, so the programs bound to it are not
+          // reported again as bound to an unknown task.
+          if (t.single) {
+            diags_.error("ST235", t.single->loc, "event tasks (SINGLE) are not supported; use INTERVAL");
+            if (!t.interval) {
+              refused_tasks.insert(canon(t.name.text));
+              continue;
+            }
+          }
           if (!t.interval) {
             diags_.error("ST227", t.loc, "task '" + t.name.text + "' needs an INTERVAL");
+            refused_tasks.insert(canon(t.name.text));
             continue;
           }
           auto iv = const_eval(*t.interval, u->file);
           if (iv && iv->k == ConstV::K::Int) ti.interval_ns = iv->i;
           if (ti.interval_ns <= 0) {
             diags_.error("ST227", t.interval->loc, "task interval must be a positive duration");
+            refused_tasks.insert(canon(t.name.text));
             continue;
           }
           if (t.priority) {
@@ -680,7 +692,8 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
                 pi.task = app_->tasks[k].name;
               }
             if (!found) {
-              diags_.error("ST227", pd.task->loc, "unknown task '" + pd.task->text + "'");
+              if (!refused_tasks.count(canon(pd.task->text)))
+                diags_.error("ST227", pd.task->loc, "unknown task '" + pd.task->text + "'");
               continue;
             }
           }

@@ -876,6 +876,13 @@ void Compiler::declare_vars(PouInfo* p) {
           }
           continue;
         }
+        // An instance of the POU being declared, by name: said once, here, before resolving
+        // the type would report the same cycle again as a recursive use (ST214).
+        if (d.type && d.type->kind == TypeSpecKind::Named && iequals(d.type->name.text, p->name) &&
+            (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program)) {
+          diags_.error("ST240", d.loc, p->name + " cannot contain an instance of itself");
+          continue;
+        }
         const Type* t = d.type ? resolve_type(*d.type, p->file) : nullptr;
         if (!t) continue;
         if (t->kind == TypeKind::Pou && t->pou == p) {

@@ -185,7 +185,7 @@ const SemaCase kCases[] = {
     {"in_out_wrong_type",
      "FUNCTION Inc : INT\nVAR_IN_OUT v : INT; END_VAR\nv := v + 1;\nInc := v;\nEND_FUNCTION\n"
      "PROGRAM Main\nVAR r : INT; d : DINT; END_VAR\nr := Inc(v := d);\nEND_PROGRAM\n",
-     "ST222", 8, 15, "VAR_IN_OUT 'v' needs a INT variable, not DINT"},
+     "ST222", 8, 15, "VAR_IN_OUT 'v' needs a variable of type INT, not DINT"},
     {"invalid_array_bounds", "PROGRAM Main\nVAR a : ARRAY [5..1] OF INT; END_VAR\nEND_PROGRAM\n", "ST229", 2, 16,
      "invalid array bounds 5..1"},
     {"empty_subrange", "PROGRAM Main\nVAR s : INT (10..1); END_VAR\nEND_PROGRAM\n", "ST229", 2, 9, "empty subrange 10..1"},
