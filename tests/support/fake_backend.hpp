@@ -31,7 +31,7 @@ class FakeBackend final : public rt::IoBackend {
     ++reads;
     if (record_log) log += "read@" + std::to_string(now_ns / 1'000'000) + " ";
     if (!fail_with.empty()) return fail();
-    std::memset(inputs, 0, in_extent_);
+    if (in_extent_) std::memset(inputs, 0, in_extent_);
     if (on_read) on_read(inputs, now_ns);
     return true;
   }
@@ -39,7 +39,7 @@ class FakeBackend final : public rt::IoBackend {
     ++writes;
     if (record_log) log += "write ";
     if (!fail_with.empty()) return fail();
-    std::memcpy(outputs.data(), out, outputs.size());
+    if (!outputs.empty()) std::memcpy(outputs.data(), out, outputs.size());  // no %Q: out may be null
     last_dt = dt_ns;
     return true;
   }
