@@ -505,9 +505,9 @@ std::string disassemble(const Application& app, const Build* build) {
   std::map<uint32_t, std::string> heads;
   for (const auto& p : app.pous) {
     if (p->is_stdlib || !p->compiled) continue;
-    if (p->kind != PouKind::Interface && p->decl) heads[p->entry] = p->name;
+    if (p->kind != PouKind::Interface && !p->is_test) heads[p->entry] = p->name;
     for (const auto& m : p->methods)
-      if (m->compiled && m->decl && m->decl->has_body) heads[m->entry] = p->name + "." + m->name;
+      if (m->compiled && m->has_body) heads[m->entry] = p->name + "." + m->name;
   }
   for (const auto& t : app.tests) {
     heads[t.setup_entry] = "TEST '" + t.name + "' (setup)";

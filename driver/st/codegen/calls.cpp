@@ -227,7 +227,7 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
         diags_.error("ST211", m.member.loc, base.type->name + " has no method '" + m.member.text + "'");
         return bad();
       }
-      if (meth->decl && meth->decl->access == Access::Private && !(b_->this_type && b_->this_type == meth->owner->type)) {
+      if (meth->access == Access::Private && !(b_->this_type && b_->this_type == meth->owner->type)) {
         diags_.error("ST211", m.member.loc, "method " + base.type->name + "." + meth->name + " is PRIVATE");
         return bad();
       }
@@ -392,7 +392,7 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     }
     passed.push_back(p);
     if (!a.value) continue;
-    ++p->writes;
+    ++sym_src(p).writes;
     Place field = inst;
     field.type = p->where == Where::InOut ? elem(TypeKind::UDInt) : p->type;
     field.off = inst.off + p->offset;
@@ -441,7 +441,7 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
       out_vals.emplace_back();
       continue;
     }
-    ++p->reads;
+    ++sym_src(p).reads;
     Place field = inst;
     field.type = p->type;
     field.off = inst.off + p->offset;
@@ -470,22 +470,31 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
 // ------------------------------------------------------------------ methods
 
 void Compiler::declare_pou(PouInfo* p) {
-  if (p->declared) return;
-  p->declared = true;
+  PouSource& ps = src(p);
+  if (ps.declared) return;
+  ps.declared = true;
   uint32_t saved = file_;
   file_ = p->file;
   if (p->kind == PouKind::Function || p->kind == PouKind::Method) {
     p->result = elem(TypeKind::Void);
-    if (p->property && !p->is_setter) p->result = p->property->type ? resolve_type(*p->property->type, p->file) : nullptr;
-    else if (p->decl && p->decl->return_type) p->result = resolve_type(*p->decl->return_type, p->file);
+    if (ps.property && !p->is_setter) p->result = ps.property->type ? resolve_type(*ps.property->type, p->file) : nullptr;
+    else if (ps.decl && ps.decl->return_type) p->result = resolve_type(*ps.decl->return_type, p->file);
     if (!p->result) p->result = elem(TypeKind::Void);
   }
-  if (p->base) ensure_compiled(p->base, p->decl ? p->decl->loc : SourceLoc{});
+  if (p->base) ensure_compiled(p->base, p->loc);
   Body* saved_b = b_;
   b_ = nullptr;
   declare_vars(p);
   b_ = saved_b;
   file_ = saved;
+  // A METHOD's inputs: the value an omitted argument gets, kept with the program so that
+  // a unit linked onto it later can call the method too.
+  if (p->kind == PouKind::Method)
+    for (Symbol* in : p->inputs) {
+      in->init.assign(in->type->size, 0);
+      const VarDecl* d = decl_of(in);
+      write_init(in->init, 0, in->type, d ? d->init.get() : nullptr, p->file);
+    }
 }
 
 // Arguments are evaluated before the method's frame is taken. FRAME names the method
@@ -590,9 +599,7 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
       if (staged[i].direct) assign(field, staged[i].v, bound[i]->loc);
       else store(field, staged[i].v.slot);
     } else {
-      std::vector<uint8_t> img(p->type->size);
-      write_init(img, 0, p->type, p->decl ? p->decl->init.get() : nullptr, m->file);
-      store(field, konst_bytes(img.data(), static_cast<uint32_t>(img.size()), p->type->align));
+      store(field, konst_bytes(p->init.data(), static_cast<uint32_t>(p->init.size()), p->type->align));
     }
   }
   mark(c.loc);
@@ -807,7 +814,7 @@ std::optional<Val> Compiler::temporal(const std::string& name, const CallExpr& c
   static const char* kOps[] = {"RISING", "FALLING", "HIGH", "LOW", "CHANGES", "INCREASES", "DECREASES", "PASSED"};
   bool known = false;
   for (const char* k : kOps) known = known || name == k;
-  if (!known || !b_->pou || !b_->pou->late) return std::nullopt;
+  if (!known || !b_->pou || !is_late(b_->pou)) return std::nullopt;
   auto args = positional(c, 1, 1, name.c_str());
   if (args.empty()) return bad();
   const Type* BOOL = elem(TypeKind::Bool);

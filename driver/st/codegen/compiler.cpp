@@ -228,10 +228,10 @@ void Compiler::compile_pou(PouInfo* p) {
   uint32_t saved_file = file_;
   b_ = nullptr;
   file_ = p->file;
-  const Pou* decl = p->decl;
+  const Pou* decl = decl_of(p);
 
   declare_pou(p);
-  if (p->kind == PouKind::Interface || (p->kind == PouKind::Method && decl && !decl->has_body) ||
+  if (p->kind == PouKind::Interface || (p->kind == PouKind::Method && !p->has_body) ||
       (p->kind == PouKind::Method && p->owner && p->owner->kind == PouKind::Interface)) {
     p->compiled = true;
     compiling_.pop_back();
@@ -298,7 +298,7 @@ void Compiler::compile_pou(PouInfo* p) {
   // Monitors: the first evaluation of a new state (input __state differs from the last
   // one seen) first shifts the temporal operators' values (previous := current); later
   // evaluations of the same state (one per timer point) see the same previous values.
-  const Symbol* state_in = p->late && p->kind == PouKind::Program ? lookup("__STATE") : nullptr;
+  const Symbol* state_in = is_late(p) && p->kind == PouKind::Program ? lookup("__STATE") : nullptr;
   Label shift = new_label(), body_start = new_label();
   Slot seen;
   if (state_in) {
@@ -319,7 +319,7 @@ void Compiler::compile_pou(PouInfo* p) {
       Slot zero = konst_i64(0);
       if (!b_->started) b_->started = hidden(1, 1);
       emit(Op::JLT_I64, {Arg::target(skip.id), seen, zero});
-      emit(Op::MOV1, {*b_->started, konst(elem(TypeKind::Bool), ConstV{ConstV::K::Bool, 1, 0, {}}, p->decl->loc)});
+      emit(Op::MOV1, {*b_->started, konst(elem(TypeKind::Bool), ConstV{ConstV::K::Bool, 1, 0, {}}, p->loc)});
       bind(skip);
       for (const auto& e : b_->edges) {
         if (e.size == 1 || e.size == 2 || e.size == 4 || e.size == 8) emit(mov_op(e.size), {e.prev, e.cur});
@@ -337,7 +337,8 @@ void Compiler::compile_pou(PouInfo* p) {
   // Warnings: variables never used (not parameters, not stdlib).
   if (opt_.warnings && !p->is_stdlib) {
     for (const auto& v : p->vars) {
-      if (v->reads || v->writes) continue;
+      const SymbolSource& vs = sym_src(v.get());
+      if (vs.reads || vs.writes) continue;
       if (v->section != VarSection::Var && v->section != VarSection::Temp) continue;
       if (v->where == Where::Abs || v->where == Where::AbsBit) continue;  // I/O mapping
       if (p->kind == PouKind::Program || p->kind == PouKind::FunctionBlock) {
@@ -364,7 +365,7 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   p->const_from = const_base;
   p->consts = b.consts;
   // Monitors: where the state shift works, so a caller can do it natively (StateShift).
-  if (p->late && p->kind == PouKind::Program && b.state_seen) {
+  if (is_late(p) && p->kind == PouKind::Program && b.state_seen) {
     auto at = [&](Slot sl) { return sl.off + (sl.kind == SK::Hidden ? hidden_base : 0); };
     p->shift.present = true;
     p->shift.seen = at(*b.state_seen);
@@ -375,14 +376,16 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   // The frame's initial image: header, variables' initial values, constants.
   std::vector<uint8_t> image(frame_size, 0);
   // Monitors: the last state seen starts at -1 (no state evaluated yet).
-  if (p->late && p->kind == PouKind::Program && b.hidden_size >= 8) {
+  if (is_late(p) && p->kind == PouKind::Program && b.hidden_size >= 8) {
     int64_t minus_one = -1;
     std::memcpy(image.data() + hidden_base, &minus_one, 8);
   }
   if (p->base && p->base->type) std::copy(p->base->type->init.begin(), p->base->type->init.end(), image.begin());
   if (p->type_id) put<uint16_t>(image.data(), static_cast<uint16_t>(p->type_id));
-  for (const auto& v : p->vars)
-    if (v->where == Where::Frame) write_init(image, v->offset, v->type, v->decl ? v->decl->init.get() : nullptr, p->file);
+  for (const auto& v : p->vars) {
+    const VarDecl* vd = decl_of(v.get());
+    if (v->where == Where::Frame) write_init(image, v->offset, v->type, vd ? vd->init.get() : nullptr, p->file);
+  }
   std::copy(b.consts.begin(), b.consts.end(), image.begin() + const_base);
 
   if (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) {
@@ -442,10 +445,13 @@ void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
   p->type = tt_->make(TypeKind::Pou, p->name);
   p->type->pou = p;
   p->type_id = next_type_id_++;
+  p->loc = tc.loc;
+  p->is_test = true;
+  PouSource& ps = src(p);
   if (tf.setup)
-    for (const auto& blk : tf.setup->var_blocks) p->blocks.push_back(&blk);
-  for (const auto& blk : tc.var_blocks) p->blocks.push_back(&blk);
-  p->declared = true;
+    for (const auto& blk : tf.setup->var_blocks) ps.blocks.push_back(&blk);
+  for (const auto& blk : tc.var_blocks) ps.blocks.push_back(&blk);
+  ps.declared = true;
   Body* saved_b = b_;
   b_ = nullptr;
   file_ = tf.file;
@@ -513,11 +519,11 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   for (const auto* u : all) index_unit(*u, u->file < sm_.size() && sm_.file(u->file).path == "<stdlib>");
   size_t first_late = app_->pous.size();
   for (const auto* u : late) index_unit(*u, false);
-  for (size_t i = first_late; i < app_->pous.size(); ++i) app_->pous[i]->late = true;
+  for (size_t i = first_late; i < app_->pous.size(); ++i) src(app_->pous[i].get()).late = true;
 
   // Inheritance and interfaces.
   auto link = [&](PouInfo* p) {
-    const Pou* d = p->decl;
+    const Pou* d = decl_of(p);
     if (!d) return;
     if (d->extends) {
       auto it = pous_.find(canon(d->extends->text));
@@ -546,7 +552,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
     size_t depth = 0;
     for (PouInfo* b = p->base; b; b = b->base)
       if (++depth > app_->pous.size()) {
-        diags_.error("ST226", p->decl->loc, "'" + p->name + "' inherits from itself");
+        diags_.error("ST226", p->loc, "'" + p->name + "' inherits from itself");
         p->base = nullptr;
         break;
       }
@@ -567,7 +573,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
       todo.insert(todo.end(), i->interfaces.begin(), i->interfaces.end());
     }
     if (cycle) {
-      const Pou& d = *p->decl;
+      const Pou& d = *decl_of(p.get());
       SourceLoc at = d.extends ? d.extends->loc : !d.implements.empty() ? d.implements[0].loc : d.name.loc;
       diags_.error("ST226", at, "interface '" + p->name + "' extends itself");
       p->interfaces.clear();
@@ -605,12 +611,12 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
 
   // Every POU is compiled (and so checked), used or not.
   for (size_t i = 0; i < app_->pous.size(); ++i)
-    if (!app_->pous[i]->late) ensure_compiled(app_->pous[i].get(), app_->pous[i]->decl->loc);
-  for (size_t i = 0; i < all_methods_.size(); ++i) ensure_compiled(all_methods_[i], all_methods_[i]->decl->loc);
+    if (!is_late(app_->pous[i].get())) ensure_compiled(app_->pous[i].get(), app_->pous[i]->loc);
+  for (size_t i = 0; i < all_methods_.size(); ++i) ensure_compiled(all_methods_[i], all_methods_[i]->loc);
 
   // Interface conformance: every method of every implemented interface must exist.
   for (const auto& p : app_->pous) {
-    if (p->kind != PouKind::FunctionBlock || p->decl->is_abstract) continue;
+    if (p->kind != PouKind::FunctionBlock || p->is_abstract) continue;
     std::vector<const PouInfo*> checked;
     std::function<void(const PouInfo*)> check = [&](const PouInfo* itf) {
       if (std::find(checked.begin(), checked.end(), itf) != checked.end()) return;
@@ -619,12 +625,12 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
         PouInfo* impl = nullptr;
         for (PouInfo* f = p.get(); f && !impl; f = f->base)
           for (const auto& fm : f->methods)
-            if (iequals(fm->name, m->name) && fm->decl->has_body) impl = fm.get();
+            if (iequals(fm->name, m->name) && fm->has_body) impl = fm.get();
         if (!impl) {
-          std::string what = m->property ? "property '" + m->property->name.text + "'" : "method '" + m->name + "'";
-          diags_.error("ST225", p->decl->name.loc, p->name + " does not implement " + what + " of interface " + itf->name);
+          std::string what = !m->property.empty() ? "property '" + m->property + "'" : "method '" + m->name + "'";
+          diags_.error("ST225", decl_of(p.get())->name.loc, p->name + " does not implement " + what + " of interface " + itf->name);
         } else if (impl->inputs.size() != m->inputs.size() || !same_type(impl->result, m->result)) {
-          diags_.error("ST225", impl->decl->name.loc, "method " + p->name + "." + impl->name + " does not match the signature in interface " + itf->name);
+          diags_.error("ST225", decl_of(impl)->name.loc, "method " + p->name + "." + impl->name + " does not match the signature in interface " + itf->name);
         }
       }
       for (const auto* e : itf->interfaces) check(e);
@@ -704,7 +710,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   }
   if (!app_->has_configuration && !opt_.test_mode) {
     for (const auto& p : app_->pous)
-      if (p->kind == PouKind::Program && !p->is_stdlib && !p->late) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
+      if (p->kind == PouKind::Program && !p->is_stdlib && !is_late(p.get())) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
   }
   for (auto& pi : app_->programs) {
     if (!pi.pou->compiled) continue;
@@ -720,8 +726,8 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   // Late units see the program instances by path.
   instance_paths_ = true;
   for (const auto& p : app_->pous) {
-    if (!p->late) continue;
-    ensure_compiled(p.get(), p->decl->loc);
+    if (!is_late(p.get())) continue;
+    ensure_compiled(p.get(), p->loc);
     if (p->kind == PouKind::Program && p->compiled) {
       ProgramInstance oi{p->name, p.get(), alloc(p->frame_size, 8), ""};
       std::copy(p->type->init.begin(), p->type->init.end(), app_->init_image.begin() + oi.addr);
@@ -742,7 +748,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
     if (!p->type_id) continue;
     for (const PouInfo* f = p.get(); f; f = f->base)
       for (const auto& m : f->methods) {
-        if (!m->decl || !m->decl->has_body || !m->compiled) continue;
+        if (!m->has_body || !m->compiled) continue;
         uint32_t& slot = app_->vtable[static_cast<size_t>(m->selector) * app_->n_types + p->type_id];
         if (slot == 0) slot = m->entry;  // the most derived implementation wins
       }

@@ -138,6 +138,24 @@ struct Body {
   std::optional<Slot> state_seen;  // the last __state evaluated
 };
 
+// What the compiler knows of a POU beyond the compiled program: its declaration in the
+// syntax tree and how far its compilation got. The POUs of a program that a second unit
+// is linked onto have none: they are finished.
+struct PouSource {
+  const Pou* decl = nullptr;
+  std::vector<const VarBlock*> blocks;     // declaration blocks (tests merge SETUP's)
+  const PropertyDecl* property = nullptr;  // getter/setter of this property
+  bool declared = false;                   // signature and variable layout done
+  bool late = false;                       // compiled after the program instances (monitors)
+};
+
+// A variable's declaration (initializer, for constants) and its uses, for the "never
+// used" warnings.
+struct SymbolSource {
+  const VarDecl* decl = nullptr;
+  uint32_t reads = 0, writes = 0;
+};
+
 class Compiler {
  public:
   Compiler(const SourceManager& sm, DiagEngine& diags, const CompileOptions& opt);
@@ -252,6 +270,24 @@ class Compiler {
   Val native(Native n, const Type* result, std::initializer_list<Slot> args, uint32_t cap = 0);
   Val native_list(Native n, const Type* result, const std::vector<Slot>& args, uint32_t cap = 0);
 
+  // ---- side tables: the compiler's knowledge of the syntax tree, kept out of the program
+  PouSource& src(const PouInfo* p) { return pou_src_[p]; }
+  const Pou* decl_of(const PouInfo* p) const {
+    auto it = pou_src_.find(p);
+    return it == pou_src_.end() ? nullptr : it->second.decl;
+  }
+  bool is_late(const PouInfo* p) const {
+    auto it = pou_src_.find(p);
+    return it != pou_src_.end() && it->second.late;
+  }
+  SymbolSource& sym_src(const Symbol* s) { return sym_src_[s]; }
+  const VarDecl* decl_of(const Symbol* s) const {
+    auto it = sym_src_.find(s);
+    return it == sym_src_.end() ? nullptr : it->second.decl;
+  }
+  std::unordered_map<const PouInfo*, PouSource> pou_src_;
+  std::unordered_map<const Symbol*, SymbolSource> sym_src_;
+
   // ---- state
   const SourceManager& sm_;
   DiagEngine& diags_;
@@ -273,7 +309,7 @@ class Compiler {
   std::unordered_map<std::string, uint32_t> selectors_;
   std::vector<PouInfo*> all_methods_;
   std::vector<std::pair<uint32_t, PouInfo*>> entry_fix_;  // absolute code index -> POU entry
-  std::unordered_map<std::string, std::unique_ptr<Symbol>> enum_syms_;
+  mutable std::unordered_map<std::string, std::unique_ptr<Symbol>> enum_syms_;  // made on first lookup
   const Type* null_type_ = nullptr;
   const PouInfo* decl_pou_ = nullptr;  // POU whose declarations are being laid out
   std::unordered_map<std::string, std::pair<const VarDecl*, uint32_t>> global_consts_;

@@ -53,11 +53,16 @@ void Compiler::index_pou(const Pou& p, uint32_t file, bool stdlib, PouInfo* owne
   PouInfo* pi = info.get();
   pi->kind = p.kind;
   pi->name = p.name.text;
-  pi->decl = &p;
+  pi->loc = p.loc;
   pi->file = file;
   pi->is_stdlib = stdlib;
   pi->owner = owner;
-  for (const auto& blk : p.var_blocks) pi->blocks.push_back(&blk);
+  pi->has_body = p.has_body;
+  pi->access = p.access;
+  pi->is_abstract = p.is_abstract;
+  PouSource& ps = src(pi);
+  ps.decl = &p;
+  for (const auto& blk : p.var_blocks) ps.blocks.push_back(&blk);
   if (p.kind == PouKind::Program || p.kind == PouKind::FunctionBlock) {
     pi->type = tt_->make(TypeKind::Pou, p.name.text);
     pi->type->pou = pi;
@@ -93,12 +98,17 @@ void Compiler::index_pou(const Pou& p, uint32_t file, bool stdlib, PouInfo* owne
       auto a = std::make_unique<PouInfo>();
       a->kind = PouKind::Method;
       a->name = std::string(k == 0 ? "__GET_" : "__SET_") + canon(prop->name.text);
-      a->decl = acc.get();
+      a->loc = acc->loc;
       a->file = file;
       a->is_stdlib = stdlib;
       a->owner = pi;
-      for (const auto& blk : acc->var_blocks) a->blocks.push_back(&blk);
-      a->property = prop.get();
+      a->has_body = acc->has_body;
+      a->access = acc->access;
+      a->property = prop->name.text;
+      PouSource& as = src(a.get());
+      as.decl = acc.get();
+      for (const auto& blk : acc->var_blocks) as.blocks.push_back(&blk);
+      as.property = prop.get();
       a->is_setter = k == 1;
       a->selector = selector(a->name);
       all_methods_.push_back(a.get());
@@ -443,8 +453,9 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
         if (!c && const_depth_hits_ != hits) too_deep_consts_.insert(&init);
         return c;
       };
-      if (s && s->kind == SymKind::Var && s->constant && s->decl && s->decl->init) {
-        auto c = init_value(*s->decl->init, file);
+      const VarDecl* sd = s && s->kind == SymKind::Var && s->constant ? decl_of(s) : nullptr;
+      if (sd && sd->init) {
+        auto c = init_value(*sd->init, file);
         if (c && s->type && s->type->is_real() && c->k == ConstV::K::Int) {
           c->k = ConstV::K::Real;
           c->r = static_cast<double>(c->i);
@@ -460,7 +471,7 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
           return nullptr;
         };
         if (decl_pou_)
-          for (const VarBlock* blk : decl_pou_->blocks)
+          for (const VarBlock* blk : src(decl_pou_).blocks)
             for (const auto& d : blk->decls)
               if (const Expr* init = const_init(d)) return init_value(*init, decl_pou_->file);
         auto gc = global_consts_.find(key);
@@ -670,7 +681,7 @@ void Compiler::write_init(std::vector<uint8_t>& image, uint32_t offset, const Ty
 // ------------------------------------------------------------------ addresses
 
 bool Compiler::locate(const DirectAddrExpr& a, const Type* t, uint32_t* addr, uint8_t* bit, bool* is_bit) {
-  const ImageArea* area = app_->image(a.area);
+  ImageArea* area = a.area == 'I' ? &app_->image_i : a.area == 'Q' ? &app_->image_q : a.area == 'M' ? &app_->image_m : nullptr;
   if (!area) {
     diags_.error("ST218", a.loc, "unknown address area in " + a.text);
     return false;
@@ -716,8 +727,7 @@ bool Compiler::locate(const DirectAddrExpr& a, const Type* t, uint32_t* addr, ui
     }
   }
   *addr = area->addr + static_cast<uint32_t>(byte);
-  auto* used = const_cast<ImageArea*>(area);
-  used->used = std::max<uint32_t>(used->used, static_cast<uint32_t>(byte + unit));
+  area->used = std::max<uint32_t>(area->used, static_cast<uint32_t>(byte + unit));
   return true;
 }
 
@@ -740,8 +750,8 @@ void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::s
         s->section = VarSection::Global;
         s->constant = d.constant;
         s->retain = d.retain;
-        s->decl = &d;
         s->loc = n.loc;
+        sym_src(s.get()).decl = &d;
         if (d.location) {
           bool is_bit = false;
           if (!locate(*d.location, t, &s->offset, &s->bit, &is_bit)) continue;
@@ -800,8 +810,8 @@ void Compiler::declare_vars(PouInfo* p) {
     s->section = d.section;
     s->constant = d.constant;
     s->retain = d.retain;
-    s->decl = &d;
     s->loc = n.loc;
+    sym_src(s.get()).decl = &d;
     Symbol* raw = s.get();
     p->vars.push_back(std::move(s));
     declared.insert(std::move(key));
@@ -830,22 +840,23 @@ void Compiler::declare_vars(PouInfo* p) {
       }
     }
     if (!is_callable && sec == VarSection::Temp) p->init_from = off;
-    if (sec == VarSection::Input && p->is_setter && p->property) {
+    const PropertyDecl* prop = src(p).property;
+    if (sec == VarSection::Input && p->is_setter && prop) {
       // A property setter receives the new value under the property's name.
-      const Type* t = p->property->type ? resolve_type(*p->property->type, p->file) : nullptr;
+      const Type* t = prop->type ? resolve_type(*prop->type, p->file) : nullptr;
       if (t) {
         auto s = std::make_unique<Symbol>();
-        s->name = p->property->name.text;
+        s->name = prop->name.text;
         s->type = t;
         s->section = VarSection::Input;
-        s->loc = p->property->name.loc;
-        s->reads = 1;
+        s->loc = prop->name.loc;
+        sym_src(s.get()).reads = 1;
         place_var(s.get(), t->size, t->align);
         p->inputs.push_back(s.get());
         p->vars.push_back(std::move(s));
       }
     }
-    for (const VarBlock* blkp : p->blocks) {
+    for (const VarBlock* blkp : src(p).blocks) {
       const VarBlock& blk = *blkp;
       if (blk.section != sec) continue;
       for (const auto& d : blk.decls) {
@@ -872,7 +883,8 @@ void Compiler::declare_vars(PouInfo* p) {
             s->offset = it->second->offset;
             s->bit = it->second->bit;
             s->constant = d.constant || it->second->constant;
-            if (!s->decl->init && it->second->decl) s->decl = it->second->decl;
+            SymbolSource& ss = sym_src(s);
+            if (!ss.decl->init && decl_of(it->second)) ss.decl = decl_of(it->second);
           }
           continue;
         }
@@ -949,7 +961,7 @@ void Compiler::ensure_compiled(PouInfo* p, SourceLoc use) {
     for (auto* c : compiling_) chain += c->name + " -> ";
     auto& d = diags_.error("ST214", use, "recursive use of '" + p->name + "' (" + chain + p->name +
                                              "); IEC 61131-3 forbids recursion and instances containing themselves");
-    d.notes.emplace_back(p->decl->name.loc, "'" + p->name + "' is declared here");
+    if (const Pou* pd = decl_of(p)) d.notes.emplace_back(pd->name.loc, "'" + p->name + "' is declared here");
     return;
   }
   compile_pou(p);

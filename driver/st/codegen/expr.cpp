@@ -127,7 +127,7 @@ const Symbol* Compiler::lookup(const std::string& key) const {
         s->enum_value = v;
       }
     auto* raw = s.get();
-    const_cast<Compiler*>(this)->enum_syms_[key] = std::move(s);
+    enum_syms_[key] = std::move(s);
     return raw;
   }
   return nullptr;
@@ -206,15 +206,14 @@ Place Compiler::place(const Expr& e, bool for_write) {
       const Symbol* s = lookup(key);
       PouInfo* self = b_ ? b_->pou : nullptr;
       if (s && s->kind == SymKind::Var) {
-        if (for_write) ++s->writes;
-        else ++s->reads;
-        const_cast<NameExpr&>(n).sym = s;
+        if (for_write) ++sym_src(s).writes;
+        else ++sym_src(s).reads;
         return symbol_place(s, e.loc);
       }
       // Inside a FUNCTION or METHOD, its own name is the result variable.
       if (self && (self->kind == PouKind::Function || self->kind == PouKind::Method) && self->result &&
           self->result->kind != TypeKind::Void &&
-          (iequals(self->name, n.name.text) || (self->property && iequals(self->property->name.text, n.name.text)))) {
+          (iequals(self->name, n.name.text) || (!self->property.empty() && iequals(self->property, n.name.text)))) {
         return frame_place(Slot{self->result_offset, SK::Var}, self->result);
       }
       if (s && s->kind == SymKind::EnumValue) {
@@ -258,8 +257,8 @@ Place Compiler::place(const Expr& e, bool for_write) {
           }
           for (const auto& g : app_->globals)
             if (iequals(g.scope, bn.name.text) && iequals(g.sym->name, m.member.text)) {
-              if (for_write) ++g.sym->writes;
-              else ++g.sym->reads;
+              if (for_write) ++sym_src(g.sym).writes;
+              else ++sym_src(g.sym).reads;
               return symbol_place(g.sym, e.loc);
             }
         }
@@ -351,7 +350,7 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
   if (!f && t->kind == TypeKind::Pou && t->pou) {
     // Located variables of an instance live in the I/O image.
     if (Symbol* s = t->pou->find_var(member.text); s && (s->where == Where::Abs || s->where == Where::AbsBit)) {
-      ++s->reads;
+      ++sym_src(s).reads;
       return symbol_place(s, loc);
     }
   }
@@ -361,8 +360,9 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
   }
   if (t->kind == TypeKind::Pou && t->pou) {
     if (Symbol* s = t->pou->find_var(member.text)) {
-      ++s->reads;
-      ++s->writes;
+      SymbolSource& ss = sym_src(s);
+      ++ss.reads;
+      ++ss.writes;
     }
   }
   Place p = base;
@@ -915,11 +915,12 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
           diags_.error("ST230", e.loc, "'" + n.name.text + "' is a value of several enumerations; write Type#" + n.name.text);
           return bad();
         }
-        if (s && s->constant && s->decl && s->decl->init && s->type && s->type->is_elementary() &&
-            s->decl->init->kind != ExprKind::ArrayInit && s->decl->init->kind != ExprKind::StructInit) {
-          auto c = const_eval(*s->decl->init, file_, false);
+        const VarDecl* sd = s && s->constant ? decl_of(s) : nullptr;
+        if (sd && sd->init && s->type && s->type->is_elementary() && sd->init->kind != ExprKind::ArrayInit &&
+            sd->init->kind != ExprKind::StructInit) {
+          auto c = const_eval(*sd->init, file_, false);
           if (c) {
-            ++s->reads;
+            ++sym_src(s).reads;
             Val v;
             v.is_const = true;
             v.c = *c;
@@ -931,7 +932,7 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
             return v;
           }
         }
-        bool is_result = b_ && b_->pou && ((b_->pou->property && iequals(b_->pou->property->name.text, key)) ||
+        bool is_result = b_ && b_->pou && ((!b_->pou->property.empty() && iequals(b_->pou->property, key)) ||
                                            ((b_->pou->kind == PouKind::Function || b_->pou->kind == PouKind::Method) &&
                                             iequals(b_->pou->name, key)));
         if (!s && !is_result && b_ && b_->this_type && b_->this_type->pou) {
@@ -1010,7 +1011,6 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
     }
     return bad();
   }();
-  const_cast<Expr&>(e).type = r.type;
   return r;
 }
 
@@ -1088,7 +1088,6 @@ Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
     Val r = expr(*n.rhs, l.type && l.type->kind == TypeKind::Enum ? l.type : (is_cmp(n.op) ? nullptr : want[k]));
     if (!r.ok) return bad();
     l = combine(n.op, l, r, n.loc);
-    if (k > 0) const_cast<BinaryExpr&>(n).type = l.type;  // expr() records the top node's
   }
   return l;
 }

@@ -228,7 +228,7 @@ void Compiler::assign_stmt(const AssignStmt& s) {
   if (s.lhs->kind == ExprKind::Name && b_->this_type && b_->this_type->pou) {
     std::string key = canon(static_cast<const NameExpr&>(*s.lhs).name.text);
     const PouInfo* cur = b_->pou;
-    bool is_result = cur && ((cur->property && iequals(cur->property->name.text, key)) || iequals(cur->name, key));
+    bool is_result = cur && ((!cur->property.empty() && iequals(cur->property, key)) || iequals(cur->name, key));
     if (!lookup(key) && !is_result) {
       if (PouInfo* st = b_->this_type->pou->find_method("__SET_" + key)) {
         Place self = this_place(s.loc);

@@ -7,7 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "syntax/ast.hpp"
+#include "syntax/kinds.hpp"
+#include "syntax/source.hpp"
 
 namespace plcfi::st {
 
@@ -28,6 +29,7 @@ enum class TypeKind : uint8_t {
 enum class Storage : uint8_t { I8, I16, I32, I64, U8, U16, U32, U64, F32, F64, Block };
 
 struct PouInfo;
+struct Type;
 
 struct Field {
   std::string name;   // spelling of the declaration

@@ -1,6 +1,7 @@
-// The ST abstract syntax tree: what the parser produces and semantic analysis annotates.
-// Every node carries the location of its first token. Names keep their spelling; compare
-// them with iequals()/canon(). Fields under "sema:" are empty after parsing.
+// The ST abstract syntax tree: what the parser produces. The compiler reads it and never
+// writes to it: what it learns (types, symbols) lives in its own tables. Every node
+// carries the location of its first token. Names keep their spelling; compare them with
+// iequals()/canon().
 #pragma once
 
 #include <cstdint>
@@ -9,12 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "kinds.hpp"
 #include "source.hpp"
 
 namespace plcfi::st {
-
-struct Type;    // sema/types.hpp
-struct Symbol;  // sema/sema.hpp
 
 struct Ident {
   std::string text;
@@ -61,8 +60,6 @@ struct Expr {
   virtual ~Expr() = default;
   ExprKind kind;
   SourceLoc loc;
-  // sema:
-  const Type* type = nullptr;
 };
 using ExprPtr = std::unique_ptr<Expr>;
 
@@ -86,8 +83,6 @@ struct EnumLiteralExpr : Expr {
 struct NameExpr : Expr {
   explicit NameExpr(SourceLoc l) : Expr(ExprKind::Name, l) {}
   Ident name;
-  // sema:
-  const Symbol* sym = nullptr;
 };
 
 // %[IQM][XBWDL]?a.b.c
@@ -103,8 +98,6 @@ struct MemberExpr : Expr {
   explicit MemberExpr(SourceLoc l) : Expr(ExprKind::Member, l) {}
   ExprPtr base;
   Ident member;
-  // sema:
-  const Symbol* sym = nullptr;
 };
 
 struct BitAccessExpr : Expr {
@@ -227,17 +220,6 @@ using TypeSpecPtr = std::unique_ptr<TypeSpec>;
 
 // ---------------------------------------------------------------- declarations
 
-enum class VarSection {
-  Var,        // VAR
-  Input,      // VAR_INPUT
-  Output,     // VAR_OUTPUT
-  InOut,      // VAR_IN_OUT
-  Temp,       // VAR_TEMP
-  Global,     // VAR_GLOBAL
-  External,   // VAR_EXTERNAL
-  Stat,       // VAR_STAT (treated as VAR)
-  Config,     // VAR_CONFIG (parsed, not used)
-};
 
 // One declaration line: `a, b AT %IX0.0 : INT := 5;` (AT only with a single name).
 struct VarDecl {
@@ -363,8 +345,6 @@ struct MockFunctionStmt : Stmt {
 
 // ---------------------------------------------------------------- POUs
 
-enum class PouKind { Program, FunctionBlock, Function, Method, Interface };
-enum class Access { Public, Private, Protected, Internal };
 
 struct PropertyDecl;
 

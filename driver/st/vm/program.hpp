@@ -1,6 +1,8 @@
 // The compiled application: bytecode, its line table, the cold-start memory image, the
-// layout of every POU and variable, tasks and program instances. Immutable after compile;
-// any number of Machines can run it.
+// layout of every POU and variable, tasks and program instances. It stands alone: nothing
+// in it points into the syntax tree or holds the compiler's bookkeeping, so it outlives
+// the sources it came from. Immutable once built (a second compilation unit may be linked
+// onto it, see codegen/compiler.hpp); any number of Machines can run it.
 #pragma once
 
 #include <array>
@@ -10,7 +12,8 @@
 #include <vector>
 
 #include "sema/types.hpp"
-#include "syntax/ast.hpp"
+#include "syntax/kinds.hpp"
+#include "syntax/source.hpp"
 
 namespace plcfi::st {
 
@@ -51,12 +54,10 @@ struct Symbol {
   VarSection section = VarSection::Var;
   bool constant = false;
   bool retain = false;
-  const VarDecl* decl = nullptr;
   SourceLoc loc;
   int64_t enum_value = 0;      // EnumValue
   PouInfo* pou = nullptr;      // Pou
-  mutable uint32_t reads = 0;  // for "unused variable" warnings
-  mutable uint32_t writes = 0;
+  std::vector<uint8_t> init;   // METHOD input: the value an omitted argument gets
 };
 
 // Layout and code of one POU (FUNCTION, FUNCTION_BLOCK, PROGRAM, METHOD, INTERFACE).
@@ -73,7 +74,7 @@ struct StateShift {
 struct PouInfo {
   PouKind kind = PouKind::Program;
   std::string name;
-  const Pou* decl = nullptr;
+  SourceLoc loc;       // of the declaration
   uint32_t file = 0;
   Type* type = nullptr;           // FB/PROGRAM/INTERFACE: instance type
   const Type* result = nullptr;   // FUNCTION/METHOD: result type (Void when none)
@@ -83,9 +84,11 @@ struct PouInfo {
   std::vector<std::unique_ptr<Symbol>> vars;   // declaration order; parameters first
   std::vector<Symbol*> inputs, outputs, inouts;
   std::vector<std::unique_ptr<PouInfo>> methods;
-  std::vector<const VarBlock*> blocks;          // declaration blocks (tests merge SETUP's)
-  const PropertyDecl* property = nullptr;       // getter/setter of this property
+  std::string property;     // property getter/setter: the property's name
   bool is_setter = false;
+  bool has_body = true;     // METHOD: false when abstract or declared by an interface
+  Access access = Access::Public;  // METHOD
+  bool is_abstract = false;        // FUNCTION_BLOCK
   uint32_t type_id = 0;     // FB/PROGRAM: index into the dispatch table
   uint32_t frame_size = 0;  // instance size (FB/PROGRAM) or frame size (FUNCTION/METHOD)
   uint32_t result_offset = 0;
@@ -100,12 +103,10 @@ struct PouInfo {
   std::vector<uint8_t> consts;
   uint32_t selector = 0;    // METHOD: global selector for dynamic dispatch
   uint32_t mock_addr = 0;   // FUNCTION in test builds: {flag, pad, value} block
-  bool declared = false;    // signature and variable layout done
-  bool compiled = false;
-  bool late = false;        // compiled after the program instances (monitors)
+  bool compiled = false;    // has code (entry, frame layout)
   StateShift shift;         // late PROGRAMs with __state
   bool is_stdlib = false;
-  bool recursion_mark = false;
+  bool is_test = false;     // a TEST of a test file: its entries are in Application::tests
 
   Symbol* find_var(std::string_view name) const;
   PouInfo* find_method(std::string_view name) const;  // searches bases too
