@@ -286,18 +286,18 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   }
   out->cases = std::move(cases);
 
-  // 4. Everything in one build.
+  // 4. Preconditions and monitors linked onto the program of step 1 (compiled once).
   out->monitor_source = monitor::generate_monitors(out->monitors);
   out->preconditions_source = precondition_program(out->cases);
   // Class formulas are instantiated per case with other text in their placeholders:
   // their messages point at the formula's start.
   st::GeneratedSources late = {{"<preconditions>", out->preconditions_source, precondition_origins(out->cases, c.tsd.path)},
                                out->monitor_source.source(out->monitors.path, false)};
-  out->build = st::build_files(c.programs, opt, late);
-  if (!out->build->ok()) {
-    *err = out->build->diags.render_all();
+  if (!st::link_generated(*prog, late, opt)) {
+    *err = prog->diags.render_all();
     return false;
   }
+  out->build = std::move(prog);
   const st::Application& app = *out->build->app;
   const st::Symbol* pre = nullptr;
   for (const auto& o : app.observers)
@@ -309,15 +309,6 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   if (!pre) {
     *err = "internal: the precondition program is missing from the build";
     return false;
-  }
-  // The fault targets again, against this build (the first one, and its types, are gone).
-  for (auto& tc : out->cases) {
-    std::string e;
-    if (!rt::parse_image_ref(app, tc.target->bind, &tc.target_ref, &e)) {
-      *err = "internal: " + e;
-      return false;
-    }
-    tc.target_ref.text = address_text(tc.target_ref);
   }
   out->preconditions.path = std::string(kPreProgram) + ".pre";
   out->preconditions.type = pre->type;

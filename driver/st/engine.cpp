@@ -32,15 +32,13 @@ std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32
     if (is_test_file(b->sm, f)) b->tests.push_back(parse_test_file(b->sm, f, b->diags));
     else b->units.push_back(parse_unit(b->sm, f, b->diags));
   }
-  for (const auto& g : late) b->late.push_back(parse_unit(b->sm, b->sm.add_generated(g.name, g.text, g.origins), b->diags));
   if (b->diags.has_errors() || !b->io_errors.empty()) return b;
   std::vector<const CompilationUnit*> units;
   for (const auto& u : b->units) units.push_back(u.get());
   std::vector<const TestFile*> tests;
   for (const auto& t : b->tests) tests.push_back(t.get());
-  std::vector<const CompilationUnit*> late_units;
-  for (const auto& u : b->late) late_units.push_back(u.get());
-  b->app = compile(b->sm, units, tests, b->diags, opt, late_units);
+  b->app = compile(b->sm, units, tests, b->diags, opt);
+  if (b->app && !late.empty() && !link_generated(*b, late, opt)) b->app.reset();
   return b;
 }
 
@@ -67,6 +65,16 @@ std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileO
   std::vector<uint32_t> files{add_stdlib(*b)};
   for (const auto& [name, text] : sources) files.push_back(b->sm.add(name, text));
   return finish(std::move(b), files, opt, late);
+}
+
+bool link_generated(Build& b, const GeneratedSources& late, const CompileOptions& opt) {
+  if (!b.app) return false;
+  const size_t first = b.late.size();
+  for (const auto& g : late) b.late.push_back(parse_unit(b.sm, b.sm.add_generated(g.name, g.text, g.origins), b.diags));
+  if (b.diags.has_errors()) return false;
+  std::vector<const CompilationUnit*> units;
+  for (size_t i = first; i < b.late.size(); ++i) units.push_back(b.late[i].get());
+  return link_units(*b.app, b.sm, units, b.diags, opt);
 }
 
 // ------------------------------------------------------------------ handles
@@ -203,14 +211,16 @@ std::optional<VarHandle> resolve(const Application& app, std::string_view path, 
     *err = "path '" + std::string(path) + "': " + msg;
     return std::nullopt;
   };
-  // First part: a program instance, a global, or a global's scope (GVL, configuration).
-  for (const auto& pi : app.programs)
-    if (iequals(pi.name, parts[0].name) && parts[0].indices.empty()) {
-      t = pi.pou->type;
-      pou = pi.pou;
-      h.addr = pi.addr;
-      i = 1;
-    }
+  // First part: a program instance (or a linked unit's observer), a global, or a
+  // global's scope (GVL, configuration).
+  for (const auto* list : {&app.programs, &app.observers})
+    for (const auto& pi : *list)
+      if (i == 0 && iequals(pi.name, parts[0].name) && parts[0].indices.empty()) {
+        t = pi.pou->type;
+        pou = pi.pou;
+        h.addr = pi.addr;
+        i = 1;
+      }
   auto from_sym = [&](const Symbol* s) {
     t = s->type;
     h.addr = s->offset;

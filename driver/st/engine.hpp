@@ -41,11 +41,16 @@ struct GeneratedSource {
 };
 using GeneratedSources = std::vector<GeneratedSource>;
 // Reads and compiles files. Returns the build; check ok(), diags and io_errors. `late`
-// sources (requirement monitors) are compiled after the program instances exist.
+// sources (requirement monitors) are then linked onto the program (link_generated).
 std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const CompileOptions& opt,
                                    const GeneratedSources& late = {});
 // Same from in-memory sources (name, text): tests, benchmarks, trace programs.
 std::unique_ptr<Build> build_sources(const NamedSources& sources, const CompileOptions& opt, const GeneratedSources& late = {});
+// Links generated ST (monitors, preconditions, probes) onto a build whose program
+// compiled: the sources join the build's, and are compiled against the program's symbols
+// (see link_units), not together with it. False, with the diagnostics in b.diags and the
+// program as it was, when they do not compile.
+bool link_generated(Build& b, const GeneratedSources& late, const CompileOptions& opt);
 
 // A variable resolved once from its path (`Main.seq.step`, `GVL.x`, `x`, `%IX0.3`,
 // `Main.buf[3].v`, `Main.w.2`) to a typed location; reads and writes are O(1).

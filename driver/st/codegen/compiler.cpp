@@ -493,34 +493,52 @@ void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
 
 // ------------------------------------------------------------------ the whole run
 
-std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUnit*>& units,
-                                           const std::vector<const TestFile*>& tests,
-                                           const std::vector<const CompilationUnit*>& late) {
-  app_ = std::make_unique<Application>();
+// ------------------------------------------------------------------ the whole run
+
+// A new, empty program: the type table, the null reference, the I/O image areas.
+void Compiler::start_program() {
+  owned_ = std::make_unique<Application>();
+  app_ = owned_.get();
   app_->types = std::make_unique<TypeTable>();
   tt_ = app_->types.get();
-  {
-    Type* n = tt_->make(TypeKind::Ref, "NULL");
-    n->size = 4;
-    n->align = 4;
-    n->target = elem(TypeKind::Void);
-    n->init.assign(4, 0);
-    null_type_ = n;
-  }
+  null_type_ = tt_->null_ref();
   for (size_t i = 0; i < sm_.size(); ++i) app_->file_paths.push_back(sm_.file(static_cast<uint32_t>(i)).path);
-
   alloc(16, 16);  // address 0 stays invalid: it is the null reference
   app_->image_i = {'I', alloc(opt_.image_size_i, 8), opt_.image_size_i, 0};
   app_->image_q = {'Q', alloc(opt_.image_size_q, 8), opt_.image_size_q, 0};
   app_->image_m = {'M', alloc(opt_.image_size_m, 8), opt_.image_size_m, 0};
+}
 
-  std::vector<const CompilationUnit*> all = units;
-  for (const auto* t : tests) all.push_back(&t->decls);
-  for (const auto* u : all) index_unit(*u, u->file < sm_.size() && sm_.file(u->file).path == "<stdlib>");
-  size_t first_late = app_->pous.size();
-  for (const auto* u : late) index_unit(*u, false);
-  for (size_t i = first_late; i < app_->pous.size(); ++i) src(app_->pous[i].get()).late = true;
+// A program compiled before, to link more units onto: its names are found again from
+// its own symbol table (POUs, globals, declared types, method selectors), not from the
+// syntax tree it came from.
+void Compiler::start_from(Application& app) {
+  app_ = &app;
+  tt_ = app.types.get();
+  null_type_ = tt_->null_ref();
+  for (size_t i = app.file_paths.size(); i < sm_.size(); ++i) app.file_paths.push_back(sm_.file(static_cast<uint32_t>(i)).path);
+  for (const auto& p : app.pous) {
+    src(p.get()).declared = true;  // and compiled: nothing of it is redone
+    if (p->is_test) continue;
+    pous_[canon(p->name)] = p.get();
+    for (const auto& m : p->methods) {
+      src(m.get()).declared = true;
+      selectors_[canon(m->name)] = m->selector;
+      next_selector_ = std::max(next_selector_, m->selector + 1);
+    }
+  }
+  for (const auto& g : app.global_syms) globals_[canon(g->name)] = g.get();
+  for (const auto& [name, t] : app.type_names) {
+    types_[canon(name)] = TypeEntry{nullptr, 0, t, false};
+    if (t->kind == TypeKind::Enum)
+      for (const auto& [v, n] : t->enum_values) enum_values_[canon(v)].push_back(t);
+  }
+  next_type_id_ = app.n_types;
+}
 
+// Declarations of the units whose POUs start at app_->pous[first_pou]: inheritance,
+// global constants and variables, types.
+void Compiler::declare_units(const std::vector<const CompilationUnit*>& all, size_t first_pou) {
   // Inheritance and interfaces.
   auto link = [&](PouInfo* p) {
     const Pou* d = decl_of(p);
@@ -546,9 +564,10 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
       p->interfaces.push_back(it->second);
     }
   };
-  for (const auto& p : app_->pous) link(p.get());
+  for (size_t i = first_pou; i < app_->pous.size(); ++i) link(app_->pous[i].get());
   // Inheritance cycles would make layouts infinite.
-  for (const auto& p : app_->pous) {
+  for (size_t i = first_pou; i < app_->pous.size(); ++i) {
+    const auto& p = app_->pous[i];
     size_t depth = 0;
     for (PouInfo* b = p->base; b; b = b->base)
       if (++depth > app_->pous.size()) {
@@ -560,7 +579,8 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
 
   // An interface extending itself (directly or through others) has its EXTENDS cut, so
   // that every later walk of the graph ends.
-  for (const auto& p : app_->pous) {
+  for (size_t k = first_pou; k < app_->pous.size(); ++k) {
+    const auto& p = app_->pous[k];
     if (p->kind != PouKind::Interface) continue;
     std::vector<const PouInfo*> todo(p->interfaces.begin(), p->interfaces.end()), seen;
     bool cycle = false;
@@ -608,14 +628,12 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   // Every declared type is resolved (and so checked), used or not.
   for (auto& [key, te] : types_)
     if (!te.type) named_type(Ident{te.decl->name.text, te.decl->name.loc}, te.file);
+}
 
-  // Every POU is compiled (and so checked), used or not.
-  for (size_t i = 0; i < app_->pous.size(); ++i)
-    if (!is_late(app_->pous[i].get())) ensure_compiled(app_->pous[i].get(), app_->pous[i]->loc);
-  for (size_t i = 0; i < all_methods_.size(); ++i) ensure_compiled(all_methods_[i], all_methods_[i]->loc);
-
+void Compiler::check_interfaces(size_t first_pou) {
   // Interface conformance: every method of every implemented interface must exist.
-  for (const auto& p : app_->pous) {
+  for (size_t i = first_pou; i < app_->pous.size(); ++i) {
+    const auto& p = app_->pous[i];
     if (p->kind != PouKind::FunctionBlock || p->is_abstract) continue;
     std::vector<const PouInfo*> checked;
     std::function<void(const PouInfo*)> check = [&](const PouInfo* itf) {
@@ -638,6 +656,9 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
     for (const auto* itf : p->interfaces) check(itf);
   }
 
+}
+
+void Compiler::configure(const std::vector<const CompilationUnit*>& units) {
   // Configuration: tasks and program instances.
   for (const auto* u : units) {
     std::set<std::string> refused_tasks;  // canonical names of tasks already reported
@@ -708,9 +729,44 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
       }
     }
   }
+}
+
+// Entries of called POUs, the dispatch table, and the declared types by name (for units
+// linked later).
+void Compiler::finish_link() {
+  for (auto [idx, pou] : entry_fix_) app_->code[idx] = pou->entry;
+  app_->n_types = next_type_id_;
+  app_->vtable.assign(static_cast<size_t>(next_selector_) * app_->n_types, 0);
+  for (const auto& p : app_->pous) {
+    if (!p->type_id) continue;
+    for (const PouInfo* f = p.get(); f; f = f->base)
+      for (const auto& m : f->methods) {
+        if (!m->has_body || !m->compiled) continue;
+        uint32_t& slot = app_->vtable[static_cast<size_t>(m->selector) * app_->n_types + p->type_id];
+        if (slot == 0) slot = m->entry;  // the most derived implementation wins
+      }
+  }
+  for (const auto& [key, te] : types_)
+    if (te.decl && te.type) app_->type_names.emplace_back(te.decl->name.text, te.type);
+}
+
+std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUnit*>& units,
+                                           const std::vector<const TestFile*>& tests) {
+  start_program();
+  std::vector<const CompilationUnit*> all = units;
+  for (const auto* t : tests) all.push_back(&t->decls);
+  for (const auto* u : all) index_unit(*u, u->file < sm_.size() && sm_.file(u->file).path == "<stdlib>");
+  declare_units(all, 0);
+
+  // Every POU is compiled (and so checked), used or not.
+  for (size_t i = 0; i < app_->pous.size(); ++i) ensure_compiled(app_->pous[i].get(), app_->pous[i]->loc);
+  for (size_t i = 0; i < all_methods_.size(); ++i) ensure_compiled(all_methods_[i], all_methods_[i]->loc);
+  check_interfaces(0);
+
+  configure(units);
   if (!app_->has_configuration && !opt_.test_mode) {
     for (const auto& p : app_->pous)
-      if (p->kind == PouKind::Program && !p->is_stdlib && !is_late(p.get())) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
+      if (p->kind == PouKind::Program && !p->is_stdlib) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
   }
   for (auto& pi : app_->programs) {
     if (!pi.pou->compiled) continue;
@@ -723,47 +779,80 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   for (const auto* tf : tests)
     for (const auto& tc : tf->tests) compile_test(*tf, tc);
 
-  // Late units see the program instances by path.
-  instance_paths_ = true;
-  for (const auto& p : app_->pous) {
-    if (!is_late(p.get())) continue;
-    ensure_compiled(p.get(), p->loc);
-    if (p->kind == PouKind::Program && p->compiled) {
-      ProgramInstance oi{p->name, p.get(), alloc(p->frame_size, 8), ""};
-      std::copy(p->type->init.begin(), p->type->init.end(), app_->init_image.begin() + oi.addr);
-      app_->observers.push_back(oi);
-    }
-  }
-  instance_paths_ = false;
-
   // Method frames live on a small stack of their own.
   app_->mstack_size = 64 * 1024;
   app_->mstack_addr = alloc(app_->mstack_size, 16);
 
-  // Link: entries of called POUs, and the dispatch table.
-  for (auto [idx, pou] : entry_fix_) app_->code[idx] = pou->entry;
-  app_->n_types = next_type_id_;
-  app_->vtable.assign(static_cast<size_t>(selectors_.size()) * app_->n_types, 0);
-  for (const auto& p : app_->pous) {
-    if (!p->type_id) continue;
-    for (const PouInfo* f = p.get(); f; f = f->base)
-      for (const auto& m : f->methods) {
-        if (!m->has_body || !m->compiled) continue;
-        uint32_t& slot = app_->vtable[static_cast<size_t>(m->selector) * app_->n_types + p->type_id];
-        if (slot == 0) slot = m->entry;  // the most derived implementation wins
-      }
-  }
+  finish_link();
   if (diags_.has_errors()) return nullptr;
-  return std::move(app_);
+  return std::move(owned_);
+}
+
+bool Compiler::link(Application& app, const std::vector<const CompilationUnit*>& units) {
+  // What the program was, to put it back when the new units do not compile.
+  const size_t n_code = app.code.size(), n_lines = app.lines.size(), n_image = app.init_image.size(),
+               n_pous = app.pous.size(), n_observers = app.observers.size(), n_branches = app.branches.size(),
+               n_globals = app.globals.size(), n_global_syms = app.global_syms.size(),
+               n_files = app.file_paths.size(), n_retain = app.retain_ranges.size(), n_type_names = app.type_names.size();
+  const ImageArea image_i = app.image_i, image_q = app.image_q, image_m = app.image_m;
+
+  start_from(app);
+  for (const auto* u : units) index_unit(*u, false);
+  for (size_t i = n_pous; i < app.pous.size(); ++i) src(app.pous[i].get()).late = true;
+  declare_units(units, n_pous);
+
+  // The new units see the program instances by path (Main.step).
+  instance_paths_ = true;
+  for (size_t i = n_pous; i < app.pous.size(); ++i) {
+    PouInfo* p = app.pous[i].get();
+    ensure_compiled(p, p->loc);
+    for (const auto& m : p->methods) ensure_compiled(m.get(), m->loc);
+  }
+  check_interfaces(n_pous);
+  for (size_t i = n_pous; i < app.pous.size(); ++i) {
+    PouInfo* p = app.pous[i].get();
+    if (p->kind == PouKind::Program && p->compiled) {
+      ProgramInstance oi{p->name, p, alloc(p->frame_size, 8), ""};
+      std::copy(p->type->init.begin(), p->type->init.end(), app.init_image.begin() + oi.addr);
+      app.observers.push_back(oi);
+    }
+  }
+  instance_paths_ = false;
+
+  if (diags_.has_errors()) {
+    app.code.resize(n_code);
+    app.lines.resize(n_lines);
+    app.init_image.resize(n_image);
+    app.pous.resize(n_pous);
+    app.observers.resize(n_observers);
+    app.branches.resize(n_branches);
+    app.globals.resize(n_globals);
+    app.global_syms.resize(n_global_syms);
+    app.file_paths.resize(n_files);
+    app.retain_ranges.resize(n_retain);
+    app.type_names.resize(n_type_names);
+    app.image_i = image_i;
+    app.image_q = image_q;
+    app.image_m = image_m;
+    return false;
+  }
+  finish_link();
+  return true;
 }
 
 }  // namespace detail
 
 std::unique_ptr<Application> compile(const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
                                      const std::vector<const TestFile*>& tests, DiagEngine& diags,
-                                     const CompileOptions& options, const std::vector<const CompilationUnit*>& late) {
+                                     const CompileOptions& options) {
   detail::Compiler c(sm, diags, options);
-  return c.run(units, tests, late);
+  return c.run(units, tests);
+}
+
+bool link_units(Application& app, const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
+                DiagEngine& diags, const CompileOptions& options) {
+  detail::Compiler c(sm, diags, options);
+  return c.link(app, units);
 }
 
 }  // namespace plcfi::st

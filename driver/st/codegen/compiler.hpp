@@ -20,13 +20,19 @@ struct CompileOptions {
 
 // Compiles the units (and test files) together with the standard library. Returns null
 // when any error was reported; diagnostics are in diags either way.
-// `late` units (requirement monitors) are compiled after the program instances exist:
-// inside them a path like Main.step names that instance's variable, and each of their
-// PROGRAMs gets one instance in Application::observers (not run by any task).
 std::unique_ptr<Application> compile(const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
                                      const std::vector<const TestFile*>& tests, DiagEngine& diags,
-                                     const CompileOptions& options,
-                                     const std::vector<const CompilationUnit*>& late = {});
+                                     const CompileOptions& options);
+
+// Links a second compilation unit (requirement monitors, preconditions, probes) onto a
+// program compiled before, against that program's own symbol table: the units' POUs may
+// call its POUs, use its types and globals, and name its program instances' variables
+// by path (Main.step); each of their PROGRAMs gets one instance in
+// Application::observers (run by no task). The program's syntax tree is not needed.
+// `sm` holds the program's files and then the units' (file indices continue). Returns
+// false, with the program as it was, when any error was reported.
+bool link_units(Application& app, const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
+                DiagEngine& diags, const CompileOptions& options);
 
 // The standard library's ST source (standard FBs), compiled with every application.
 const char* stdlib_source();

@@ -160,8 +160,16 @@ class Compiler {
  public:
   Compiler(const SourceManager& sm, DiagEngine& diags, const CompileOptions& opt);
   std::unique_ptr<Application> run(const std::vector<const CompilationUnit*>& units,
-                                   const std::vector<const TestFile*>& tests,
-                                   const std::vector<const CompilationUnit*>& late);
+                                   const std::vector<const TestFile*>& tests);
+  bool link(Application& app, const std::vector<const CompilationUnit*>& units);
+
+  // ---- the stages of a run (compiler.cpp)
+  void start_program();
+  void start_from(Application& app);
+  void declare_units(const std::vector<const CompilationUnit*>& all, size_t first_pou);
+  void check_interfaces(size_t first_pou);
+  void configure(const std::vector<const CompilationUnit*>& units);
+  void finish_link();
 
   // ---- declarations (decls.cpp)
   void index_unit(const CompilationUnit& u, bool stdlib);
@@ -292,7 +300,8 @@ class Compiler {
   const SourceManager& sm_;
   DiagEngine& diags_;
   CompileOptions opt_;
-  std::unique_ptr<Application> app_;
+  std::unique_ptr<Application> owned_;  // the program being built by run()
+  Application* app_ = nullptr;          // that one, or the one link() adds to
   TypeTable* tt_ = nullptr;
   uint32_t file_ = 0;  // file of the body being compiled (for diagnostics)
 
@@ -307,6 +316,7 @@ class Compiler {
   std::unordered_map<std::string, Symbol*> globals_;
   std::unordered_map<std::string, std::vector<const Type*>> enum_values_;
   std::unordered_map<std::string, uint32_t> selectors_;
+  uint32_t next_selector_ = 0;
   std::vector<PouInfo*> all_methods_;
   std::vector<std::pair<uint32_t, PouInfo*>> entry_fix_;  // absolute code index -> POU entry
   mutable std::unordered_map<std::string, std::unique_ptr<Symbol>> enum_syms_;  // made on first lookup

@@ -29,7 +29,7 @@ uint32_t Compiler::alloc(uint32_t size, uint32_t align) {
 uint32_t Compiler::selector(const std::string& method_canon) {
   auto it = selectors_.find(method_canon);
   if (it != selectors_.end()) return it->second;
-  uint32_t id = static_cast<uint32_t>(selectors_.size());
+  uint32_t id = next_selector_++;
   selectors_[method_canon] = id;
   return id;
 }

@@ -53,6 +53,12 @@ TypeTable::TypeTable() {
     elementary_[static_cast<size_t>(e.kind)] = t.get();
     owned_.push_back(std::move(t));
   }
+  Type* n = make(TypeKind::Ref, "NULL");
+  n->size = 4;
+  n->align = 4;
+  n->target = elementary(TypeKind::Void);
+  n->init.assign(4, 0);
+  null_ = n;
 }
 
 const Type* TypeTable::by_name(std::string_view name) const {

@@ -91,10 +91,12 @@ class TypeTable {
   const Type* ref_to(const Type* target);
   Type* make(TypeKind k, std::string name);  // a new user type, to be filled by the caller
   const Type* void_type() const { return elementary(TypeKind::Void); }
+  const Type* null_ref() const { return null_; }  // the type of NULL: a reference to anything
 
  private:
   std::vector<std::unique_ptr<Type>> owned_;
   std::vector<const Type*> elementary_;
+  const Type* null_ = nullptr;
 };
 
 // IEC 61131-3 implicit conversion (widening) from `from` to `to`; exact matches included.

@@ -173,6 +173,7 @@ class Application {
   uint32_t mstack_addr = 0, mstack_size = 0;  // method frames (dynamic)
   ImageArea image_i{'I', 0, 0}, image_q{'Q', 0, 0}, image_m{'M', 0, 0};
   std::unique_ptr<TypeTable> types;
+  std::vector<std::pair<std::string, const Type*>> type_names;  // declared TYPEs, as spelt
   bool has_configuration = false;
 
   SourceLoc loc_of(uint32_t pc) const;
