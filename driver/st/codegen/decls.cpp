@@ -794,6 +794,8 @@ void Compiler::declare_vars(PouInfo* p) {
   std::unordered_set<std::string> inherited;
   if (p->base && p->base->type)
     for (const auto& f : p->base->type->fields) inherited.insert(canon(f.name));
+  const bool result_name_taken = (p->kind == PouKind::Function || p->kind == PouKind::Method) &&
+                                 (p->is_setter || (p->result && p->result->kind != TypeKind::Void));
   auto add = [&](const VarDecl& d, const Ident& n, const Type* t) -> Symbol* {
     std::string key = canon(n.text);
     if (declared.count(key)) {
@@ -802,6 +804,12 @@ void Compiler::declare_vars(PouInfo* p) {
     }
     if (inherited.count(key)) {
       diags_.error("ST202", n.loc, "'" + n.text + "' is already declared in the base FB " + p->base->name);
+      return nullptr;
+    }
+    // Names are case-insensitive: `m0` in METHOD M0 would be its result variable.
+    const std::string& result_name = p->property.empty() ? p->name : p->property;
+    if (result_name_taken && iequals(n.text, result_name)) {
+      diags_.error("ST202", n.loc, "'" + n.text + "' is declared twice in " + result_name + ": it is the result variable");
       return nullptr;
     }
     auto s = std::make_unique<Symbol>();
@@ -932,6 +940,15 @@ void Compiler::declare_vars(PouInfo* p) {
   }
   p->frame_size = align_up(off, 8);
   decl_pou_ = saved_decl_pou;
+  // A variable of an FB and one of its methods or properties spelt alike would each hide
+  // the other in the bodies.
+  for (const auto& m : p->methods) {
+    const std::string& member = m->property.empty() ? m->name : m->property;
+    for (const auto& v : p->vars)
+      if (iequals(v->name, member))
+        diags_.error("ST202", v->loc, "'" + v->name + "' is declared twice in " + p->name + ": as a variable and as a " +
+                                          (m->property.empty() ? "method" : "property"));
+  }
   // FB and PROGRAM types expose their variables as fields (paths, member access).
   if (p->type && p->kind != PouKind::Interface) {
     Type* t = p->type;
