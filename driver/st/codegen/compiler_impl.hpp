@@ -1,5 +1,5 @@
 // Internal state of the ST compiler, shared by its translation units (declarations,
-// expressions, statements, calls). Not part of the engine's public interface.
+// expressions, places, statements, calls). Not part of the engine's public interface.
 //
 // The compiler works in two stages over the AST: declarations (types, POU signatures,
 // layouts, globals) are indexed first; then each POU body is type-checked and translated
@@ -223,12 +223,29 @@ class Compiler {
   void repeat_stmt(const RepeatStmt& s);
   uint32_t branch(SourceLoc loc, const char* kind);
 
-  // ---- expressions (expr.cpp)
+  // ---- expressions, rvalues (expr.cpp)
   Val expr(const Expr& e, const Type* expected = nullptr);
   Val binary(const BinaryExpr& e, const Type* expected);
   Val combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc);
   Val unary(const UnaryExpr& e, const Type* expected);
   Val literal(const LiteralExpr& e, const Type* expected);
+  Val coerce(const Val& v, const Type* to, SourceLoc loc, const char* what);
+  Slot to_slot(const Val& v, const Type* t, SourceLoc loc);
+  Slot convert(Slot s, const Type* from, const Type* to);
+  Val cond(const Expr& e);
+  // Emits "jump to target when the condition is false (or true)"; a comparison that was
+  // just computed into a temporary becomes one fused compare-and-jump instruction.
+  // (Defined in stmt.cpp.)
+  void branch_on(const Val& c, SourceLoc loc, Label target, bool when_true);
+  Val bad() {
+    Val v;
+    v.ok = false;
+    return v;
+  }
+  const Type* default_type(const ConstV& c) const;
+  const Type* elem(TypeKind k) const { return tt_->elementary(k); }
+
+  // ---- places, lvalues (places.cpp)
   Place place(const Expr& e, bool for_write);
   Place frame_place(Slot s, const Type* t) {
     Place p;
@@ -246,22 +263,8 @@ class Compiler {
   Val load(const Place& p);
   void store(const Place& p, Slot src);
   void assign(const Place& dst, const Val& v, SourceLoc loc);
-  Val coerce(const Val& v, const Type* to, SourceLoc loc, const char* what);
-  Slot to_slot(const Val& v, const Type* t, SourceLoc loc);
-  Slot convert(Slot s, const Type* from, const Type* to);
   Slot addr_of(const Place& p, SourceLoc loc);
-  Val cond(const Expr& e);
-  // Emits "jump to target when the condition is false (or true)"; a comparison that was
-  // just computed into a temporary becomes one fused compare-and-jump instruction.
-  void branch_on(const Val& c, SourceLoc loc, Label target, bool when_true);
   const Symbol* lookup(const std::string& canon_name) const;
-  Val bad() {
-    Val v;
-    v.ok = false;
-    return v;
-  }
-  const Type* default_type(const ConstV& c) const;
-  const Type* elem(TypeKind k) const { return tt_->elementary(k); }
 
   // ---- calls (calls.cpp)
   Val call(const CallExpr& c, bool as_statement);
@@ -349,6 +352,9 @@ class Compiler {
 std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r, std::string* err);
 
 inline uint32_t align_up(uint32_t v, uint32_t a) { return a <= 1 ? v : (v + a - 1) / a * a; }
+
+// A type's name in diagnostics (expr.cpp, places.cpp); null is an untyped literal.
+inline std::string tname(const Type* t) { return t ? t->name : "an untyped literal"; }
 
 // Opcode families are laid out per storage type (see opcodes.def); these pick the member.
 uint32_t storage_index(Storage s);  // I8..F64 -> 0..9

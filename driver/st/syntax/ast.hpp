@@ -54,6 +54,8 @@ enum class BinaryOp {
   Xor,                   // XOR
   Or,                    // OR
 };
+// The operator as written in ST ("<=", "MOD", "AND").
+const char* op_text(BinaryOp op);
 
 struct Expr {
   explicit Expr(ExprKind k, SourceLoc l) : kind(k), loc(l) {}

@@ -7,27 +7,6 @@ namespace plcfi::st {
 
 namespace {
 
-const char* op_text(BinaryOp op) {
-  switch (op) {
-    case BinaryOp::Pow: return "**";
-    case BinaryOp::Mul: return "*";
-    case BinaryOp::Div: return "/";
-    case BinaryOp::Mod: return "MOD";
-    case BinaryOp::Add: return "+";
-    case BinaryOp::Sub: return "-";
-    case BinaryOp::Lt: return "<";
-    case BinaryOp::Gt: return ">";
-    case BinaryOp::Le: return "<=";
-    case BinaryOp::Ge: return ">=";
-    case BinaryOp::Eq: return "=";
-    case BinaryOp::Ne: return "<>";
-    case BinaryOp::And: return "AND";
-    case BinaryOp::Xor: return "XOR";
-    case BinaryOp::Or: return "OR";
-  }
-  return "?";
-}
-
 std::string opt(const ExprPtr& e) { return e ? dump(*e) : std::string("_"); }
 
 std::string literal(const LiteralExpr& l) {

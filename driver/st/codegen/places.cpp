@@ -1,0 +1,602 @@
+// Places (lvalues): name lookup, variables, members, array elements, dereferences,
+// THIS; loading from and storing to them, assignment and ADR.
+#include "compiler_impl.hpp"
+
+namespace plcfi::st::detail {
+
+// ------------------------------------------------------------------ names
+
+const Symbol* Compiler::lookup(const std::string& key) const {
+  if (b_) {
+    auto it = b_->locals.find(key);
+    if (it != b_->locals.end()) return it->second;
+  }
+  auto g = globals_.find(key);
+  if (g != globals_.end()) return g->second;
+  auto e = enum_syms_.find(key);
+  if (e != enum_syms_.end()) return e->second.get();
+  auto ev = enum_values_.find(key);
+  if (ev != enum_values_.end() && ev->second.size() == 1) {
+    auto s = std::make_unique<Symbol>();
+    s->kind = SymKind::EnumValue;
+    s->type = ev->second[0];
+    for (const auto& [n, v] : ev->second[0]->enum_values)
+      if (canon(n) == key) {
+        s->name = n;
+        s->enum_value = v;
+      }
+    auto* raw = s.get();
+    enum_syms_[key] = std::move(s);
+    return raw;
+  }
+  return nullptr;
+}
+
+Place Compiler::symbol_place(const Symbol* s, SourceLoc loc) {
+  Place p;
+  p.type = s->type;
+  p.sym = s;
+  p.readonly = s->constant;
+  switch (s->where) {
+    case Where::Frame: p.k = Place::K::Frame; p.off = s->offset; break;
+    case Where::Abs: p.k = Place::K::Abs; p.off = s->offset; break;
+    case Where::AbsBit: p.k = Place::K::AbsBit; p.off = s->offset; p.bit = s->bit; break;
+    case Where::InOut:
+      p.k = Place::K::Ind;
+      p.ptr = Slot{s->offset, SK::Var};
+      p.off = 0;
+      break;
+    case Where::This: {
+      p.k = Place::K::Ind;
+      p.ptr = Slot{8, SK::Var};
+      p.off = s->offset;
+      if (s->type && s->type->kind == TypeKind::Ref && s->section == VarSection::InOut) {
+        // The owner's VAR_IN_OUT: load the stored address, then go through it.
+        Slot ptr = temp(4, 4);
+        emit(Op::LDI4, {ptr, Slot{8, SK::Var}, s->offset});
+        p.ptr = ptr;
+        p.off = 0;
+        p.type = s->type->target;
+      }
+      break;
+    }
+  }
+  (void)loc;
+  return p;
+}
+
+Place Compiler::this_place(SourceLoc loc) {
+  Place p;
+  if (!b_ || !b_->this_type) {
+    diags_.error("ST231", loc, "THIS is only available inside a function block or its methods");
+    p.ok = false;
+    return p;
+  }
+  p.type = b_->this_type;
+  if (b_->is_method) {
+    p.k = Place::K::Ind;
+    p.ptr = Slot{8, SK::Var};
+  } else {
+    p.k = Place::K::Frame;
+    p.off = 0;
+  }
+  return p;
+}
+
+// ------------------------------------------------------------------ places
+
+Place Compiler::place(const Expr& e, bool for_write) {
+  Place bad_place;
+  bad_place.ok = false;
+  switch (e.kind) {
+    case ExprKind::Name: {
+      const auto& n = static_cast<const NameExpr&>(e);
+      std::string key = canon(n.name.text);
+      const Symbol* s = lookup(key);
+      PouInfo* self = b_ ? b_->pou : nullptr;
+      if (s && s->kind == SymKind::Var) {
+        if (for_write) ++sym_src(s).writes;
+        else ++sym_src(s).reads;
+        return symbol_place(s, e.loc);
+      }
+      // Inside a FUNCTION or METHOD, its own name is the result variable.
+      if (self && (self->kind == PouKind::Function || self->kind == PouKind::Method) && self->result &&
+          self->result->kind != TypeKind::Void &&
+          (iequals(self->name, n.name.text) || (!self->property.empty() && iequals(self->property, n.name.text)))) {
+        return frame_place(Slot{self->result_offset, SK::Var}, self->result);
+      }
+      if (s && s->kind == SymKind::EnumValue) {
+        diags_.error("ST206", e.loc, "'" + n.name.text + "' is an enumeration value, not a variable");
+        return bad_place;
+      }
+      if (pous_.count(key)) {
+        diags_.error("ST223", e.loc, "'" + n.name.text + "' is a POU, not a variable");
+        return bad_place;
+      }
+      diags_.error("ST200", e.loc, "unknown identifier '" + n.name.text + "'");
+      return bad_place;
+    }
+    case ExprKind::DirectAddr: {
+      const auto& a = static_cast<const DirectAddrExpr&>(e);
+      Place p;
+      TypeKind k = a.size == 'X' ? TypeKind::Bool : a.size == 'B' ? TypeKind::Byte : a.size == 'W' ? TypeKind::Word
+                   : a.size == 'D' ? TypeKind::DWord : TypeKind::LWord;
+      p.type = elem(k);
+      bool is_bit = false;
+      if (!locate(a, p.type, &p.off, &p.bit, &is_bit)) return bad_place;
+      p.k = is_bit ? Place::K::AbsBit : Place::K::Abs;
+      return p;
+    }
+    case ExprKind::Member: {
+      const auto& m = static_cast<const MemberExpr&>(e);
+      // GVL.x / Config.x: qualified access to a global.
+      if (m.base->kind == ExprKind::Name) {
+        const auto& bn = static_cast<const NameExpr&>(*m.base);
+        if (!lookup(canon(bn.name.text))) {
+          if (instance_paths_) {
+            // Main.x in a monitor: a variable of the program instance Main.
+            for (const auto& pi : app_->programs)
+              if (iequals(pi.name, bn.name.text)) {
+                Place inst;
+                inst.k = Place::K::Abs;
+                inst.type = pi.pou->type;
+                inst.off = pi.addr;
+                return member_place(inst, m.member, e.loc);
+              }
+          }
+          for (const auto& g : app_->globals)
+            if (iequals(g.scope, bn.name.text) && iequals(g.sym->name, m.member.text)) {
+              if (for_write) ++sym_src(g.sym).writes;
+              else ++sym_src(g.sym).reads;
+              return symbol_place(g.sym, e.loc);
+            }
+        }
+      }
+      Place base = place(*m.base, for_write);
+      if (!base.ok) return base;
+      return member_place(base, m.member, e.loc);
+    }
+    case ExprKind::Index: {
+      const auto& ix = static_cast<const IndexExpr&>(e);
+      Place base = place(*ix.base, for_write);
+      if (!base.ok) return base;
+      return index_place(base, ix);
+    }
+    case ExprKind::Deref: {
+      const auto& d = static_cast<const DerefExpr&>(e);
+      if (d.base->kind == ExprKind::This) return this_place(e.loc);
+      if (d.base->kind == ExprKind::Super) {
+        Place p = this_place(e.loc);
+        if (p.ok) {
+          if (!b_->this_type->pou->base && !(b_->is_method && b_->pou->owner->base)) {
+            diags_.error("ST231", e.loc, "SUPER needs a function block that EXTENDS another");
+            p.ok = false;
+          } else {
+            p.type = (b_->is_method ? b_->pou->owner : b_->this_type->pou)->base->type;
+          }
+        }
+        return p;
+      }
+      Val v = expr(*d.base);
+      if (!v.ok) return bad_place;
+      if (!v.type || v.type->kind != TypeKind::Ref) {
+        diags_.error("ST232", e.loc, "'^' needs a reference (REF_TO), not " + tname(v.type));
+        return bad_place;
+      }
+      return deref_place(v, v.type->target, e.loc);
+    }
+    case ExprKind::BitAccess: {
+      const auto& ba = static_cast<const BitAccessExpr&>(e);
+      Place base = place(*ba.base, for_write);
+      if (!base.ok) return base;
+      if (!base.type->is_integer() && !base.type->is_bitstring()) {
+        diags_.error("ST237", e.loc, "bit access needs an integer or bit-string variable, not " + base.type->name);
+        return bad_place;
+      }
+      if (ba.bit >= base.type->bit_width()) {
+        diags_.error("ST237", e.loc, "bit " + std::to_string(ba.bit) + " does not exist in " + base.type->name);
+        return bad_place;
+      }
+      Place p;
+      p.k = Place::K::Bit;
+      p.type = elem(TypeKind::Bool);
+      p.bit = static_cast<uint8_t>(ba.bit);
+      p.readonly = base.readonly;
+      p.inner = std::make_shared<Place>(base);
+      return p;
+    }
+    case ExprKind::Call: {
+      // A function result used as a structure or array: `f(x).field`.
+      Val v = expr(e);
+      if (!v.ok) return bad_place;
+      if (v.is_const || !v.type || v.type->kind == TypeKind::Void) {
+        diags_.error("ST206", e.loc, "this call has no result to select from");
+        return bad_place;
+      }
+      Place p = frame_place(v.slot, v.type);
+      p.readonly = true;
+      return p;
+    }
+    default:
+      diags_.error("ST206", e.loc, "this expression does not denote a variable");
+      return bad_place;
+  }
+}
+
+Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
+  Place bad_place;
+  bad_place.ok = false;
+  const Type* t = base.type;
+  if (t->kind == TypeKind::Ref) {
+    diags_.error("ST207", loc, "'" + t->name + "' is a reference: write '^." + member.text + "' to reach the member");
+    return bad_place;
+  }
+  if (t->kind != TypeKind::Struct && t->kind != TypeKind::Pou) {
+    diags_.error("ST207", loc, t->name + " has no members (it is not a structure or FB instance)");
+    return bad_place;
+  }
+  const Field* f = t->field(member.text);
+  if (!f && t->kind == TypeKind::Pou && t->pou) {
+    // Located variables of an instance live in the I/O image.
+    if (Symbol* s = t->pou->find_var(member.text); s && (s->where == Where::Abs || s->where == Where::AbsBit)) {
+      ++sym_src(s).reads;
+      return symbol_place(s, loc);
+    }
+  }
+  if (!f) {
+    diags_.error("ST207", member.loc, "'" + t->name + "' has no member '" + member.text + "'");
+    return bad_place;
+  }
+  if (t->kind == TypeKind::Pou && t->pou) {
+    if (Symbol* s = t->pou->find_var(member.text)) {
+      SymbolSource& ss = sym_src(s);
+      ++ss.reads;
+      ++ss.writes;
+    }
+  }
+  Place p = base;
+  p.type = f->type;
+  switch (base.k) {
+    case Place::K::Frame: case Place::K::Abs: case Place::K::Ind: p.off = base.off + f->offset; break;
+    case Place::K::FrameIdx:
+      if (!f->type->is_elementary()) {
+        // Deeper selection: go through the element's address.
+        Place ind;
+        ind.k = Place::K::Ind;
+        ind.type = base.type;
+        ind.ptr = addr_of(base, loc);
+        ind.readonly = base.readonly;
+        return member_place(ind, member, loc);
+      }
+      p.field = base.field + f->offset;
+      break;
+    default:
+      diags_.error("ST207", loc, "member access on this expression is not supported");
+      return bad_place;
+  }
+  // A VAR_IN_OUT member of an FB instance holds an address.
+  if (f->type->kind == TypeKind::Ref && t->kind == TypeKind::Pou && t->pou) {
+    Symbol* s = t->pou->find_var(member.text);
+    if (s && s->where == Where::InOut) {
+      Val ptr = load(p);
+      return deref_place(ptr, f->type->target, loc);
+    }
+  }
+  return p;
+}
+
+Place Compiler::index_place(Place base, const IndexExpr& e) {
+  Place bad_place;
+  bad_place.ok = false;
+  const Type* t = base.type;
+  if (t->kind != TypeKind::Array) {
+    diags_.error("ST208", e.loc, "'[ ]' needs an array, not " + t->name);
+    return bad_place;
+  }
+  if (e.indices.size() != t->dims.size()) {
+    diags_.error("ST208", e.loc, t->name + " needs " + std::to_string(t->dims.size()) + " index(es), not " + std::to_string(e.indices.size()));
+    return bad_place;
+  }
+  uint32_t esize = t->elem->size;
+  // Strides per dimension (row-major).
+  std::vector<uint64_t> stride(t->dims.size());
+  uint64_t s = esize;
+  for (size_t i = t->dims.size(); i-- > 0;) {
+    stride[i] = s;
+    s *= static_cast<uint64_t>(t->dims[i].hi - t->dims[i].lo + 1);
+  }
+  uint64_t const_disp = 0;
+  std::vector<std::pair<size_t, Slot>> dyn;
+  for (size_t i = 0; i < e.indices.size(); ++i) {
+    Val v = expr(*e.indices[i], elem(TypeKind::DInt));
+    if (!v.ok) return bad_place;
+    if (v.is_const) {
+      if (v.c.k != ConstV::K::Int) {
+        diags_.error("ST208", e.indices[i]->loc, "an array index must be an integer");
+        return bad_place;
+      }
+      if (v.c.i < t->dims[i].lo || v.c.i > t->dims[i].hi) {
+        diags_.error("ST209", e.indices[i]->loc, "index " + std::to_string(v.c.i) + " is outside " +
+                                                      std::to_string(t->dims[i].lo) + ".." + std::to_string(t->dims[i].hi));
+        return bad_place;
+      }
+      const_disp += static_cast<uint64_t>(v.c.i - t->dims[i].lo) * stride[i];
+      continue;
+    }
+    if (!v.type || (!v.type->is_integer() && v.type->kind != TypeKind::Enum && !v.type->is_bitstring())) {
+      diags_.error("ST208", e.indices[i]->loc, "an array index must be an integer, not " + tname(v.type));
+      return bad_place;
+    }
+    // Index arithmetic is 32-bit: a wider index (LINT, ULINT, UDINT, ...) is checked
+    // against the bounds in its own type first, so a value that only fits after
+    // truncation traps instead of reaching another element.
+    if (v.type->is_integer() || v.type->is_bitstring()) {
+      bool wide = v.type->size == 8 || (v.type->size == 4 && !v.type->is_signed());
+      if (wide) {
+        int64_t lo = t->dims[i].lo, hi = t->dims[i].hi;
+        if (!v.type->is_signed() && lo < 0) lo = 0;
+        Slot los = konst(v.type, ConstV{ConstV::K::Int, lo, 0, {}}, e.indices[i]->loc);
+        Slot his = konst(v.type, ConstV{ConstV::K::Int, hi < 0 && !v.type->is_signed() ? 0 : hi, 0, {}}, e.indices[i]->loc);
+        mark(e.indices[i]->loc);
+        emit(int_op(Op::CHK_I8, v.type->storage()), {v.slot, los, his, 1u});
+      }
+    }
+    dyn.emplace_back(i, convert(v.slot, v.type, elem(TypeKind::DInt)));
+  }
+  if (dyn.empty()) {
+    Place p = base;
+    p.type = t->elem;
+    p.off = base.off + static_cast<uint32_t>(const_disp);
+    if (base.k == Place::K::AbsBit || base.k == Place::K::Bit || base.k == Place::K::FrameIdx) return bad_place;
+    return p;
+  }
+  // Fast path: one variable index into a frame array of scalars or of structures (whose
+  // scalar fields are then reached in one instruction).
+  if (dyn.size() == 1 && base.k == Place::K::Frame && t->dims.size() == 1 &&
+      ((t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) || t->elem->kind == TypeKind::Struct ||
+       t->elem->kind == TypeKind::Pou)) {
+    Place p;
+    p.k = Place::K::FrameIdx;
+    p.type = t->elem;
+    p.off = base.off;
+    p.sk = base.sk;
+    p.idx = dyn[0].second;
+    p.lo = static_cast<int32_t>(t->dims[0].lo);
+    p.count = static_cast<uint32_t>(t->dims[0].hi - t->dims[0].lo + 1);
+    p.stride = t->elem->is_elementary() ? 0 : esize;
+    p.readonly = base.readonly;
+    return p;
+  }
+  Slot ptr = addr_of(base, e.loc);
+  Slot cur = ptr;
+  for (auto [i, idx] : dyn) {
+    Slot next = temp(4, 4);
+    emit(Op::ELEM, {next, cur, idx, static_cast<uint32_t>(static_cast<int32_t>(t->dims[i].lo)),
+                    static_cast<uint32_t>(t->dims[i].hi - t->dims[i].lo + 1), static_cast<uint32_t>(stride[i])});
+    cur = next;
+  }
+  Place p;
+  p.k = Place::K::Ind;
+  p.type = t->elem;
+  p.ptr = cur;
+  p.off = static_cast<uint32_t>(const_disp);
+  p.readonly = base.readonly;
+  return p;
+}
+
+Place Compiler::deref_place(Val ptr, const Type* target, SourceLoc loc) {
+  Place p;
+  p.k = Place::K::Ind;
+  p.type = target;
+  if (ptr.is_const) {
+    p.ptr = konst_u32(static_cast<uint32_t>(ptr.c.i));
+  } else {
+    p.ptr = ptr.slot;
+  }
+  (void)loc;
+  return p;
+}
+
+Slot Compiler::addr_of(const Place& p, SourceLoc loc) {
+  switch (p.k) {
+    case Place::K::Frame: {
+      Slot t = temp(4, 4);
+      emit(Op::ADDR, {t, Slot{p.off, p.sk}});
+      def(t);
+      return t;
+    }
+    case Place::K::Abs: return konst_u32(p.off);
+    case Place::K::Ind: {
+      if (p.off == 0) return p.ptr;
+      Slot t = temp(4, 4);
+      emit(Op::ADDRI, {t, p.ptr, p.off});
+      def(t);
+      return t;
+    }
+    case Place::K::FrameIdx: {
+      Slot a = temp(4, 4);
+      emit(Op::ADDR, {a, Slot{p.off, p.sk}});
+      Slot t = temp(4, 4);
+      emit(Op::ELEM, {t, a, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride ? p.stride : p.type->size});
+      if (p.field == 0) return t;
+      Slot f = temp(4, 4);
+      emit(Op::ADDRI, {f, t, p.field});
+      return f;
+    }
+    default:
+      diags_.error("ST232", loc, "cannot take the address of a single bit");
+      return konst_u32(0);
+  }
+}
+
+// ------------------------------------------------------------------ load/store
+
+Val Compiler::load(const Place& p) {
+  Val v;
+  v.type = p.type;
+  if (!p.ok) return bad();
+  if (p.k == Place::K::FrameIdx && !p.type->is_elementary()) {
+    Place ind = p;
+    ind.k = Place::K::Ind;
+    ind.ptr = addr_of(p, SourceLoc{});
+    ind.off = 0;
+    return load(ind);
+  }
+  uint32_t size = p.type->size;
+  switch (p.k) {
+    case Place::K::Frame: v.slot = Slot{p.off, p.sk}; return v;
+    case Place::K::Abs: {
+      Slot t = temp_for(p.type);
+      switch (size) {
+        case 1: emit(Op::LDG1, {t, p.off}); break;
+        case 2: emit(Op::LDG2, {t, p.off}); break;
+        case 4: emit(Op::LDG4, {t, p.off}); break;
+        case 8: emit(Op::LDG8, {t, p.off}); break;
+        default: emit(Op::LDGN, {t, p.off, size}); break;
+      }
+      def(t);
+      v.slot = t;
+      return v;
+    }
+    case Place::K::AbsBit: {
+      Slot t = temp(1, 1);
+      emit(Op::LDBIT, {t, p.off, p.bit});
+      def(t);
+      v.slot = t;
+      return v;
+    }
+    case Place::K::Ind: {
+      Slot t = temp_for(p.type);
+      switch (size) {
+        case 1: emit(Op::LDI1, {t, p.ptr, p.off}); break;
+        case 2: emit(Op::LDI2, {t, p.ptr, p.off}); break;
+        case 4: emit(Op::LDI4, {t, p.ptr, p.off}); break;
+        case 8: emit(Op::LDI8, {t, p.ptr, p.off}); break;
+        default: emit(Op::LDIN, {t, p.ptr, p.off, size}); break;
+      }
+      def(t);
+      v.slot = t;
+      return v;
+    }
+    case Place::K::FrameIdx: {
+      Slot t = temp_for(p.type);
+      if (p.stride) {
+        Op op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
+        emit(op, {t, Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+      } else {
+        Op op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
+        emit(op, {t, Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count});
+      }
+      def(t);
+      v.slot = t;
+      return v;
+    }
+    case Place::K::Bit: {
+      Val w = load(*p.inner);
+      Slot t = temp(1, 1);
+      uint32_t ws = p.inner->type->size;
+      Op op = ws == 1 ? Op::GETBIT1 : ws == 2 ? Op::GETBIT2 : ws == 4 ? Op::GETBIT4 : Op::GETBIT8;
+      emit(op, {t, w.slot, p.bit});
+      def(t);
+      v.slot = t;
+      return v;
+    }
+  }
+  return v;
+}
+
+void Compiler::store(const Place& p, Slot src) {
+  const Type* t = p.type;
+  if (p.k == Place::K::FrameIdx && !t->is_elementary()) {
+    Place ind = p;
+    ind.k = Place::K::Ind;
+    ind.ptr = addr_of(p, SourceLoc{});
+    ind.off = 0;
+    store(ind, src);
+    return;
+  }
+  uint32_t size = t->size;
+  if (t->is_string() && p.k == Place::K::Frame) {
+    emit(Op::SCPY, {Slot{p.off, p.sk}, src, t->str_len});
+    return;
+  }
+  if (t->is_string()) {
+    // Truncate to the destination's capacity in a temporary, then copy the buffer.
+    Slot tmp = temp(size, 1);
+    emit(Op::SCPY, {tmp, src, t->str_len});
+    src = tmp;
+  }
+  switch (p.k) {
+    case Place::K::Frame: {
+      Slot dst{p.off, p.sk};
+      if (dst.off == src.off && dst.kind == src.kind) return;
+      if (retarget(src, dst)) return;
+      if (size == 1 || size == 2 || size == 4 || size == 8) emit(mov_op(size), {dst, src});
+      else emit(Op::MOVN, {dst, src, size});
+      return;
+    }
+    case Place::K::Abs:
+      switch (size) {
+        case 1: emit(Op::STG1, {p.off, src}); return;
+        case 2: emit(Op::STG2, {p.off, src}); return;
+        case 4: emit(Op::STG4, {p.off, src}); return;
+        case 8: emit(Op::STG8, {p.off, src}); return;
+        default: emit(Op::STGN, {p.off, src, size}); return;
+      }
+    case Place::K::AbsBit: emit(Op::STBIT, {p.off, p.bit, src}); return;
+    case Place::K::Ind:
+      switch (size) {
+        case 1: emit(Op::STI1, {p.ptr, p.off, src}); return;
+        case 2: emit(Op::STI2, {p.ptr, p.off, src}); return;
+        case 4: emit(Op::STI4, {p.ptr, p.off, src}); return;
+        case 8: emit(Op::STI8, {p.ptr, p.off, src}); return;
+        default: emit(Op::STIN, {p.ptr, p.off, src, size}); return;
+      }
+    case Place::K::FrameIdx: {
+      if (p.stride) {
+        Op op = size == 1 ? Op::STXS1 : size == 2 ? Op::STXS2 : size == 4 ? Op::STXS4 : Op::STXS8;
+        emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        return;
+      }
+      Op op = size == 1 ? Op::STX1 : size == 2 ? Op::STX2 : size == 4 ? Op::STX4 : Op::STX8;
+      emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, src});
+      return;
+    }
+    case Place::K::Bit: {
+      uint32_t ws = p.inner->type->size;
+      Op op = ws == 1 ? Op::SETBIT1 : ws == 2 ? Op::SETBIT2 : ws == 4 ? Op::SETBIT4 : Op::SETBIT8;
+      if (p.inner->k == Place::K::Frame) {
+        emit(op, {Slot{p.inner->off, p.inner->sk}, p.bit, src});
+        return;
+      }
+      Val w = load(*p.inner);
+      Slot tmp = temp_for(p.inner->type);
+      emit(mov_op(ws), {tmp, w.slot});
+      emit(op, {tmp, p.bit, src});
+      store(*p.inner, tmp);
+      return;
+    }
+  }
+}
+
+void Compiler::assign(const Place& dst, const Val& v, SourceLoc loc) {
+  if (!dst.ok || !v.ok) return;
+  if (dst.readonly) {
+    diags_.error("ST206", loc, dst.sym ? "'" + dst.sym->name + "' is a constant and cannot be assigned" : "this expression cannot be assigned");
+    return;
+  }
+  Val c = coerce(v, dst.type, loc, "assignment");
+  if (!c.ok) return;
+  Slot s = to_slot(c, dst.type, loc);
+  if (dst.type->ranged && dst.type->is_integer()) {
+    Slot lo = konst(dst.type, ConstV{ConstV::K::Int, dst.type->lo, 0, {}}, loc);
+    Slot hi = konst(dst.type, ConstV{ConstV::K::Int, dst.type->hi, 0, {}}, loc);
+    if (!(c.is_const)) {
+      mark(loc);
+      emit(int_op(Op::CHK_I8, dst.type->storage()), {s, lo, hi, 0u});
+    }
+  }
+  store(dst, s);
+}
+
+}  // namespace plcfi::st::detail
