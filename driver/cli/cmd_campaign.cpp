@@ -171,18 +171,7 @@ std::string json_cases(const CampaignBuild& cb) {
 // Parses the common arguments; returns 0 to go on, else the exit status (help, usage).
 int parse(const std::string& cmd, const std::string& usage, po::options_description& desc, const std::vector<std::string>& args,
           po::variables_map* vm) {
-  desc.add_options()("help,h", "show this help");
-  po::options_description all;
-  all.add(desc);
-  all.add_options()("campaign-file", po::value<std::vector<std::string>>(), "");
-  po::positional_options_description pos;
-  pos.add("campaign-file", -1);
-  po::store(po::command_line_parser(args).options(all).positional(pos).run(), *vm);
-  po::notify(*vm);
-  if (vm->count("help")) {
-    std::cout << "usage: " << usage << "\n\n" << desc << "\n";
-    return -1;
-  }
+  if (!parse_args(args, desc, *vm, usage, "campaign-file")) return -1;
   if (!vm->count("campaign-file") || (*vm)["campaign-file"].as<std::vector<std::string>>().size() != 1) {
     std::cerr << "plcfi " << cmd << ": expected one campaign file\nusage: " << usage << "\n";
     return 2;

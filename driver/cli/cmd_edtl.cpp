@@ -5,8 +5,9 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
-#include "json.hpp"
 #include "engine.hpp"
+#include "json.hpp"
+#include "options.hpp"
 #include "monitor/edtl.hpp"
 #include "report/junit.hpp"
 #include "runtime/schedule.hpp"
@@ -75,20 +76,12 @@ int cmd_edtl(const std::vector<std::string>& args) {
   }
   po::options_description desc("plcfi edtl check: EDTL requirements on a recorded trace");
   desc.add_options()("cycle-time", po::value<std::string>(), "time between states when the trace has no time column (default 1s); for VCD: sample every cycle")
-      ("junit", po::value<std::string>(), "write JUnit XML")("json", "print the verdicts as JSON")("help,h", "show this help");
-  po::options_description all;
-  all.add(desc);
-  all.add_options()("files", po::value<std::vector<std::string>>(), "");
-  po::positional_options_description pos;
-  pos.add("files", -1);
+      ("junit", po::value<std::string>(), "write JUnit XML")("json", "print the verdicts as JSON");
   po::variables_map vm;
-  po::store(po::command_line_parser(std::vector<std::string>(args.begin() + 1, args.end())).options(all).positional(pos).run(), vm);
-  po::notify(vm);
-  if (vm.count("help")) {
-    std::cout << "usage: plcfi edtl check REQS.yaml TRACE [--cycle-time 1s] [--junit F] [--json]\n\n" << desc << "\n";
+  if (!parse_args(std::vector<std::string>(args.begin() + 1, args.end()), desc, vm,
+                  "plcfi edtl check REQS.yaml TRACE [--cycle-time 1s] [--junit F] [--json]"))
     return 0;
-  }
-  auto files = vm.count("files") ? vm["files"].as<std::vector<std::string>>() : std::vector<std::string>{};
+  auto files = strings_of(vm, "files");
   if (files.size() != 2) {
     std::cerr << "plcfi edtl check: expected REQS.yaml and TRACE\n";
     return 2;

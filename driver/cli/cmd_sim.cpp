@@ -129,21 +129,11 @@ int cmd_sim(const std::vector<std::string>& args) {
       ("alarms", po::value<std::vector<std::string>>(), "alarm variables to report (default: BOOL globals named *Error*, *Alarm*, *Warning*, *Stop*, *Fault*)")
       ("requirements", po::value<std::string>(), "EDTL requirements (YAML) checked every scan")
       ("native", "run the program (and the monitors) through the native tier");
-  desc.add_options()("help,h", "show this help");
-  po::options_description all;
-  all.add(desc);
-  all.add_options()("files", po::value<std::vector<std::string>>(), "");
-  po::positional_options_description pos;
-  pos.add("files", -1);
   po::variables_map vm;
-  po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
-  po::notify(vm);
-  if (vm.count("help")) {
-    std::cout << "usage: plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
-                 "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml]\n\n"
-              << desc << "\n";
+  if (!parse_args(args, desc, vm,
+                  "plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
+                  "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml]"))
     return 0;
-  }
   std::vector<std::string> files;
   if (vm.count("program")) files = vm["program"].as<std::vector<std::string>>();
   if (vm.count("files"))

@@ -23,30 +23,6 @@ namespace plcfi::cli {
 
 namespace {
 
-// Parses args into vm; returns false when --help was printed.
-bool parse(const std::vector<std::string>& args, po::options_description& desc, po::variables_map& vm,
-           const char* usage_line, bool files = true) {
-  desc.add_options()("help,h", "show this help");
-  po::options_description all;
-  all.add(desc);
-  po::positional_options_description pos;
-  if (files) {
-    all.add_options()("files", po::value<std::vector<std::string>>(), "ST files");
-    pos.add("files", -1);
-  }
-  po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
-  po::notify(vm);
-  if (vm.count("help")) {
-    std::cout << "usage: " << usage_line << "\n\n" << desc << "\n";
-    return false;
-  }
-  return true;
-}
-
-std::vector<std::string> files_of(const po::variables_map& vm) {
-  return vm.count("files") ? vm["files"].as<std::vector<std::string>>() : std::vector<std::string>{};
-}
-
 // Compiles and prints diagnostics. Returns null after printing why.
 std::unique_ptr<st::Build> load(const std::vector<std::string>& files, const st::CompileOptions& opt, const char* cmd) {
   if (files.empty()) {
@@ -87,11 +63,11 @@ int cmd_check(const std::vector<std::string>& args) {
   po::options_description desc("plcfi check: compile ST files and report every error and warning");
   desc.add_options()("no-warnings", "report errors only");
   po::variables_map vm;
-  if (!parse(args, desc, vm, "plcfi check FILES... [--no-warnings]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi check FILES... [--no-warnings]")) return 0;
   st::CompileOptions opt;
   opt.warnings = !vm.count("no-warnings");
   opt.test_mode = true;  // test files may be checked too; their built-ins are then known
-  auto b = load(files_of(vm), opt, "check");
+  auto b = load(strings_of(vm, "files"), opt, "check");
   if (!b) return 2;
   if (!b->io_errors.empty()) return 2;
   size_t errors = b->diags.error_count(), warnings = b->diags.warning_count();
@@ -103,10 +79,10 @@ int cmd_disasm(const std::vector<std::string>& args) {
   po::options_description desc("plcfi disasm: print the bytecode of ST files with their source lines");
   desc.add_options()("native", "print the C++ the native tier generates instead");
   po::variables_map vm;
-  if (!parse(args, desc, vm, "plcfi disasm FILES... [--native]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi disasm FILES... [--native]")) return 0;
   st::CompileOptions opt;
   opt.warnings = false;
-  auto b = load(files_of(vm), opt, "disasm");
+  auto b = load(strings_of(vm, "files"), opt, "disasm");
   if (!b || !b->ok()) return 2;
   if (vm.count("native")) {
     std::vector<uint32_t> entries, skipped;
@@ -137,10 +113,10 @@ int cmd_run(const std::vector<std::string>& args) {
       ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with --realtime: pin the scan thread to this CPU")
       ("junit", po::value<std::string>(), "with --io or --realtime: JUnit XML with the wake latency, execution time and overruns as properties");
   po::variables_map vm;
-  if (!parse(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE] [--realtime [--rt-priority N] [--cpu N]] [--duration T] [--junit F]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE] [--realtime [--rt-priority N] [--cpu N]] [--duration T] [--junit F]")) return 0;
   st::CompileOptions opt;
   opt.warnings = false;
-  auto b = load(files_of(vm), opt, "run");
+  auto b = load(strings_of(vm, "files"), opt, "run");
   if (!b || !b->ok()) return 2;
   const st::Application& app = *b->app;
 
@@ -277,11 +253,11 @@ int cmd_test(const std::vector<std::string>& args) {
       ("budget", po::value<Count>()->default_value(Count{100'000'000}, "100000000"), "loop iterations allowed per test phase (watchdog)")
       ("native", "run the tests through the native tier (generated C++, compiled by the system's compiler)");
   po::variables_map vm;
-  if (!parse(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage]")) return 0;
   st::CompileOptions opt;
   opt.test_mode = true;
   opt.warnings = false;
-  auto b = load(files_of(vm), opt, "test");
+  auto b = load(strings_of(vm, "files"), opt, "test");
   if (!b || !b->ok()) return 2;
   if (b->tests.empty()) {
     std::cerr << "plcfi test: no test file among the inputs (a test file starts with TEST, SETUP or TEARDOWN)\n";

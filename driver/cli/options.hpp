@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <iostream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -79,5 +80,34 @@ void validate(boost::any& out, const std::vector<std::string>& values, IntIn<Lo,
 
 using RtPriority = IntIn<0, 99>;  // SCHED_FIFO priority; 0 keeps the normal scheduler
 using CpuIndex = IntIn<-1, 1023>;  // CPU affinity; -1 leaves the thread on any CPU
+
+// Parses a subcommand's arguments: its options, and plain arguments collected under the
+// name `positional` (none when null). --help prints the usage line and the options and
+// returns false; errors throw boost::program_options::error, reported by main.
+inline bool parse_args(const std::vector<std::string>& args, boost::program_options::options_description& desc,
+                       boost::program_options::variables_map& vm, const std::string& usage,
+                       const char* positional = "files") {
+  namespace po = boost::program_options;
+  desc.add_options()("help,h", "show this help");
+  po::options_description all;
+  all.add(desc);
+  po::positional_options_description pos;
+  if (positional) {
+    all.add_options()(positional, po::value<std::vector<std::string>>(), "");
+    pos.add(positional, -1);
+  }
+  po::store(po::command_line_parser(args).options(all).positional(pos).run(), vm);
+  po::notify(vm);
+  if (vm.count("help")) {
+    std::cout << "usage: " << usage << "\n\n" << desc << "\n";
+    return false;
+  }
+  return true;
+}
+
+// The values of a repeatable string option or of the plain arguments; empty when absent.
+inline std::vector<std::string> strings_of(const boost::program_options::variables_map& vm, const char* key) {
+  return vm.count(key) ? vm[key].as<std::vector<std::string>>() : std::vector<std::string>{};
+}
 
 }  // namespace plcfi::cli

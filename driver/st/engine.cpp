@@ -17,14 +17,6 @@
 namespace plcfi::st {
 
 namespace {
-template <class T>
-T ld(const uint8_t* p) {
-  return load_as<T>(p);
-}
-template <class T>
-void st(uint8_t* p, T v) {
-  store_as<T>(p, v);
-}
 
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32_t>& files, const CompileOptions& opt,
                               const GeneratedSources& late) {
@@ -319,24 +311,24 @@ int64_t read_int(const Machine& m, const VarHandle& h) {
   if (h.is_bit) return (m.mem()[h.addr] >> h.bit) & 1u;
   const uint8_t* p = m.mem() + h.addr;
   switch (h.type->storage()) {
-    case Storage::I8: return ld<int8_t>(p);
-    case Storage::I16: return ld<int16_t>(p);
-    case Storage::I32: return ld<int32_t>(p);
-    case Storage::I64: return ld<int64_t>(p);
-    case Storage::U8: return ld<uint8_t>(p);
-    case Storage::U16: return ld<uint16_t>(p);
-    case Storage::U32: return ld<uint32_t>(p);
-    case Storage::U64: return static_cast<int64_t>(ld<uint64_t>(p));
-    case Storage::F32: return static_cast<int64_t>(std::llround(ld<float>(p)));
-    case Storage::F64: return static_cast<int64_t>(std::llround(ld<double>(p)));
+    case Storage::I8: return load_as<int8_t>(p);
+    case Storage::I16: return load_as<int16_t>(p);
+    case Storage::I32: return load_as<int32_t>(p);
+    case Storage::I64: return load_as<int64_t>(p);
+    case Storage::U8: return load_as<uint8_t>(p);
+    case Storage::U16: return load_as<uint16_t>(p);
+    case Storage::U32: return load_as<uint32_t>(p);
+    case Storage::U64: return static_cast<int64_t>(load_as<uint64_t>(p));
+    case Storage::F32: return static_cast<int64_t>(std::llround(load_as<float>(p)));
+    case Storage::F64: return static_cast<int64_t>(std::llround(load_as<double>(p)));
     default: return 0;
   }
 }
 
 double read_real(const Machine& m, const VarHandle& h) {
-  if (h.type->kind == TypeKind::Real) return ld<float>(m.mem() + h.addr);
-  if (h.type->kind == TypeKind::LReal) return ld<double>(m.mem() + h.addr);
-  if (h.type->storage() == Storage::U64) return static_cast<double>(ld<uint64_t>(m.mem() + h.addr));
+  if (h.type->kind == TypeKind::Real) return load_as<float>(m.mem() + h.addr);
+  if (h.type->kind == TypeKind::LReal) return load_as<double>(m.mem() + h.addr);
+  if (h.type->storage() == Storage::U64) return static_cast<double>(load_as<uint64_t>(m.mem() + h.addr));
   return static_cast<double>(read_int(m, h));
 }
 
@@ -351,25 +343,25 @@ void write_int(Machine& m, const VarHandle& h, int64_t v) {
   }
   // The width decides for integers, enums, times and bits (the hot path of drivers and
   // monitors); only the REAL types convert.
-  if (h.type->kind == TypeKind::Real) return st<float>(p, static_cast<float>(v));
-  if (h.type->kind == TypeKind::LReal) return st<double>(p, static_cast<double>(v));
+  if (h.type->kind == TypeKind::Real) return store_as<float>(p, static_cast<float>(v));
+  if (h.type->kind == TypeKind::LReal) return store_as<double>(p, static_cast<double>(v));
   switch (h.type->kind) {
     case TypeKind::String: case TypeKind::WString: case TypeKind::Array: case TypeKind::Struct: case TypeKind::Pou:
     case TypeKind::Void: return;
     default: break;
   }
   switch (h.type->size) {
-    case 1: st<uint8_t>(p, static_cast<uint8_t>(h.type->kind == TypeKind::Bool ? v != 0 : v)); break;
-    case 2: st<uint16_t>(p, static_cast<uint16_t>(v)); break;
-    case 4: st<uint32_t>(p, static_cast<uint32_t>(v)); break;
-    case 8: st<uint64_t>(p, static_cast<uint64_t>(v)); break;
+    case 1: store_as<uint8_t>(p, static_cast<uint8_t>(h.type->kind == TypeKind::Bool ? v != 0 : v)); break;
+    case 2: store_as<uint16_t>(p, static_cast<uint16_t>(v)); break;
+    case 4: store_as<uint32_t>(p, static_cast<uint32_t>(v)); break;
+    case 8: store_as<uint64_t>(p, static_cast<uint64_t>(v)); break;
     default: break;
   }
 }
 
 void write_real(Machine& m, const VarHandle& h, double v) {
-  if (h.type->kind == TypeKind::Real) st<float>(m.mem() + h.addr, static_cast<float>(v));
-  else if (h.type->kind == TypeKind::LReal) st<double>(m.mem() + h.addr, v);
+  if (h.type->kind == TypeKind::Real) store_as<float>(m.mem() + h.addr, static_cast<float>(v));
+  else if (h.type->kind == TypeKind::LReal) store_as<double>(m.mem() + h.addr, v);
   else write_int(m, h, static_cast<int64_t>(std::llround(v)));
 }
 
@@ -399,9 +391,9 @@ std::string format(const Machine& m, const VarHandle& h) {
   if (h.is_bit || t->kind == TypeKind::Bool) return read_bool(m, h) ? "TRUE" : "FALSE";
   const uint8_t* p = m.mem() + h.addr;
   switch (t->kind) {
-    case TypeKind::Real: return fmt::format("{}", ld<float>(p));
-    case TypeKind::LReal: return fmt::format("{}", ld<double>(p));
-    case TypeKind::Time: case TypeKind::LTime: return duration(ld<int64_t>(p));
+    case TypeKind::Real: return fmt::format("{}", load_as<float>(p));
+    case TypeKind::LReal: return fmt::format("{}", load_as<double>(p));
+    case TypeKind::Time: case TypeKind::LTime: return duration(load_as<int64_t>(p));
     case TypeKind::String: case TypeKind::WString: {
       const char* s = reinterpret_cast<const char*>(p);
       return "'" + std::string(s, strnlen(s, t->str_len)) + "'";
@@ -412,7 +404,7 @@ std::string format(const Machine& m, const VarHandle& h) {
         if (x == v) return n;
       return t->name + "#" + std::to_string(v);
     }
-    case TypeKind::ULInt: case TypeKind::LWord: return std::to_string(ld<uint64_t>(p));
+    case TypeKind::ULInt: case TypeKind::LWord: return std::to_string(load_as<uint64_t>(p));
     case TypeKind::Byte: case TypeKind::Word: case TypeKind::DWord: return fmt::format("16#{:X}", read_int(m, h));
     case TypeKind::Array: case TypeKind::Struct: case TypeKind::Pou: return "(" + t->name + ")";
     default: return std::to_string(read_int(m, h));

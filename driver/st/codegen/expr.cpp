@@ -13,16 +13,30 @@ bool is_cmp(BinaryOp op) {
          op == BinaryOp::Eq || op == BinaryOp::Ne;
 }
 bool is_logic(BinaryOp op) { return op == BinaryOp::And || op == BinaryOp::Or || op == BinaryOp::Xor; }
+// The six comparisons on two folded operands of one kind; nullopt for other operators.
+template <class T>
+std::optional<bool> compare(BinaryOp op, T x, T y) {
+  switch (op) {
+    case BinaryOp::Lt: return x < y;
+    case BinaryOp::Gt: return x > y;
+    case BinaryOp::Le: return x <= y;
+    case BinaryOp::Ge: return x >= y;
+    case BinaryOp::Eq: return x == y;
+    case BinaryOp::Ne: return x != y;
+    default: return std::nullopt;
+  }
+}
+ConstV bool_const(bool b) {
+  ConstV c;
+  c.k = ConstV::K::Bool;
+  c.i = b;
+  return c;
+}
 }  // namespace
 
 std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r, std::string* err) {
   if (l.k == ConstV::K::Str || r.k == ConstV::K::Str) {
-    if (l.k == r.k && (op == BinaryOp::Eq || op == BinaryOp::Ne)) {
-      ConstV c;
-      c.k = ConstV::K::Bool;
-      c.i = (l.s == r.s) == (op == BinaryOp::Eq);
-      return c;
-    }
+    if (l.k == r.k && (op == BinaryOp::Eq || op == BinaryOp::Ne)) return bool_const((l.s == r.s) == (op == BinaryOp::Eq));
     *err = "string constants cannot be combined with " + std::string(op_text(op));
     return std::nullopt;
   }
@@ -40,16 +54,9 @@ std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r,
       case BinaryOp::Pow: c.r = std::pow(x, y); return c;
       default: break;
     }
-    c.k = ConstV::K::Bool;
-    switch (op) {
-      case BinaryOp::Lt: c.i = x < y; return c;
-      case BinaryOp::Gt: c.i = x > y; return c;
-      case BinaryOp::Le: c.i = x <= y; return c;
-      case BinaryOp::Ge: c.i = x >= y; return c;
-      case BinaryOp::Eq: c.i = x == y; return c;
-      case BinaryOp::Ne: c.i = x != y; return c;
-      default: *err = std::string(op_text(op)) + " is not applicable to REAL values"; return std::nullopt;
-    }
+    if (auto b = compare(op, x, y)) return bool_const(*b);
+    *err = std::string(op_text(op)) + " is not applicable to REAL values";
+    return std::nullopt;
   }
   int64_t x = l.i, y = r.i;
   auto ux = static_cast<uint64_t>(x), uy = static_cast<uint64_t>(y);
@@ -72,16 +79,9 @@ std::optional<ConstV> fold_binary(BinaryOp op, const ConstV& l, const ConstV& r,
     case BinaryOp::Xor: c.i = x ^ y; return c;
     default: break;
   }
-  c.k = ConstV::K::Bool;
-  switch (op) {
-    case BinaryOp::Lt: c.i = x < y; return c;
-    case BinaryOp::Gt: c.i = x > y; return c;
-    case BinaryOp::Le: c.i = x <= y; return c;
-    case BinaryOp::Ge: c.i = x >= y; return c;
-    case BinaryOp::Eq: c.i = x == y; return c;
-    case BinaryOp::Ne: c.i = x != y; return c;
-    default: *err = "operator not applicable in a constant expression"; return std::nullopt;
-  }
+  if (auto b = compare(op, x, y)) return bool_const(*b);
+  *err = "operator not applicable in a constant expression";
+  return std::nullopt;
 }
 
 const Type* Compiler::default_type(const ConstV& c) const {

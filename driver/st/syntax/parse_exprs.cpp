@@ -9,12 +9,7 @@ namespace plcfi::st::detail {
 // expr := or_expr   (precedence climbing over the binary levels below)
 ExprPtr Parser::parse_expr() {
   DepthGuard guard(*this);
-  if (guard.exceeded) {
-    const SourceLoc loc = cur().loc;
-    report_too_deep();
-    skip_nested();
-    return error_expr(loc);
-  }
+  if (guard.exceeded) return too_deep_expr();
   return parse_binary(1);
 }
 
@@ -66,13 +61,7 @@ ExprPtr Parser::parse_binary(int min_prec) {
 ExprPtr Parser::parse_unary() {
   if (!at(Tok::Minus) && !at(Tok::Plus) && !at(Tok::Not)) return parse_power();
   DepthGuard guard(*this);
-  if (guard.exceeded) {
-    // Skip the rest of the operand without recursing (`2 ** -2 ** -2 ...` nests through here).
-    const SourceLoc loc = cur().loc;
-    report_too_deep();
-    skip_nested();
-    return error_expr(loc);
-  }
+  if (guard.exceeded) return too_deep_expr();  // `2 ** -2 ** -2 ...` nests through here
   const Token& t = advance();
   auto u = std::make_unique<UnaryExpr>(t.loc);
   u->op = t.kind == Tok::Minus ? UnaryOp::Neg : t.kind == Tok::Plus ? UnaryOp::Plus : UnaryOp::Not;
@@ -312,12 +301,7 @@ ExprPtr Parser::parse_primary() {
 // array_item := int_literal '(' [initializer] ')' | initializer
 ExprPtr Parser::parse_initializer() {
   DepthGuard guard(*this);
-  if (guard.exceeded) {
-    const SourceLoc loc = cur().loc;
-    report_too_deep();
-    skip_nested();
-    return error_expr(loc);
-  }
+  if (guard.exceeded) return too_deep_expr();
   const Token& t = cur();
   if (at(Tok::LBracket)) {
     advance();

@@ -242,6 +242,14 @@ class Parser {
     error("ST117", cur().loc, "nesting too deep (more than " + std::to_string(kMaxDepth) +
                                   " levels of parentheses, blocks or types)");
   }
+  // Past the depth limit inside an expression: report once, skip the rest of the nested
+  // text without recursing, and stand in an error node where it began.
+  ExprPtr too_deep_expr() {
+    const SourceLoc loc = cur().loc;
+    report_too_deep();
+    skip_nested();
+    return error_expr(loc);
+  }
   bool expect_ident(Ident* out, const char* code, const std::string& what);
 
   // ------------------------------------------------------------ expressions (parse_exprs.cpp)

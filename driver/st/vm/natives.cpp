@@ -15,14 +15,6 @@
 namespace plcfi::st {
 
 namespace {
-template <class T>
-T ld(const uint8_t* p) {
-  return load_as<T>(p);
-}
-template <class T>
-void st(uint8_t* p, T v) {
-  store_as<T>(p, v);
-}
 char* cs(uint8_t* p) { return reinterpret_cast<char*>(p); }
 
 // Writes [s, s+n) as the string at dst with capacity cap. Source and destination may
@@ -41,16 +33,16 @@ int64_t clamp_len(int64_t v, size_t max) {
 
 #define MATH(NAME, EXPR)                                                                    \
   void NAME##_F32(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {       \
-    float x = ld<float>(b);                                                                 \
-    float y = ld<float>(c);                                                                 \
+    float x = load_as<float>(b);                                                                 \
+    float y = load_as<float>(c);                                                                 \
     (void)y;                                                                                \
-    st<float>(a, static_cast<float>(EXPR));                                                 \
+    store_as<float>(a, static_cast<float>(EXPR));                                                 \
   }                                                                                         \
   void NAME##_F64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {       \
-    double x = ld<double>(b);                                                               \
-    double y = ld<double>(c);                                                               \
+    double x = load_as<double>(b);                                                               \
+    double y = load_as<double>(c);                                                               \
     (void)y;                                                                                \
-    st<double>(a, static_cast<double>(EXPR));                                               \
+    store_as<double>(a, static_cast<double>(EXPR));                                               \
   }
 MATH(SQRT, std::sqrt(x))
 MATH(LN, std::log(x))
@@ -67,24 +59,24 @@ MATH(EXPT, std::pow(x, y))
 
 // a: INT result, b: string
 void s_len(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  st<int16_t>(a, static_cast<int16_t>(std::strlen(cs(b))));
+  store_as<int16_t>(a, static_cast<int16_t>(std::strlen(cs(b))));
 }
 // a := LEFT(b, L = c)
 void s_left(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
   std::string s = cs(b);
-  put(a, cap, s.substr(0, clamp_len(ld<int64_t>(c), s.size())));
+  put(a, cap, s.substr(0, clamp_len(load_as<int64_t>(c), s.size())));
 }
 void s_right(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
   std::string s = cs(b);
-  auto n = clamp_len(ld<int64_t>(c), s.size());
+  auto n = clamp_len(load_as<int64_t>(c), s.size());
   put(a, cap, s.substr(s.size() - n));
 }
 // a := MID(b, L = c, P = d), P 1-based
 void s_mid(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
   std::string s = cs(b);
-  int64_t p = ld<int64_t>(d);
+  int64_t p = load_as<int64_t>(d);
   if (p < 1 || static_cast<size_t>(p) > s.size()) return put(a, cap, "", 0);
-  put(a, cap, s.substr(p - 1, clamp_len(ld<int64_t>(c), s.size())));
+  put(a, cap, s.substr(p - 1, clamp_len(load_as<int64_t>(c), s.size())));
 }
 void s_concat(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
   put(a, cap, std::string(cs(b)) + cs(c));
@@ -92,21 +84,21 @@ void s_concat(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_
 // a := INSERT(IN1 = b, IN2 = c, P = d): IN2 inserted after the P-th character of IN1
 void s_insert(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
   std::string s = cs(b);
-  auto p = clamp_len(ld<int64_t>(d), s.size());
+  auto p = clamp_len(load_as<int64_t>(d), s.size());
   s.insert(p, cs(c));
   put(a, cap, s);
 }
 // a := DELETE(IN = b, L = c, P = d): L characters from position P
 void s_delete(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
   std::string s = cs(b);
-  int64_t p = ld<int64_t>(d);
-  if (p >= 1 && static_cast<size_t>(p) <= s.size()) s.erase(p - 1, clamp_len(ld<int64_t>(c), s.size()));
+  int64_t p = load_as<int64_t>(d);
+  if (p >= 1 && static_cast<size_t>(p) <= s.size()) s.erase(p - 1, clamp_len(load_as<int64_t>(c), s.size()));
   put(a, cap, s);
 }
 // a := REPLACE(IN1 = b, IN2 = c, L = d[0], P = d[1])
 void s_replace(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
   std::string s = cs(b);
-  int64_t l = ld<int64_t>(d), p = ld<int64_t>(d + 8);
+  int64_t l = load_as<int64_t>(d), p = load_as<int64_t>(d + 8);
   if (p < 1) p = 1;
   if (static_cast<size_t>(p) > s.size() + 1) p = static_cast<int64_t>(s.size()) + 1;
   s.replace(p - 1, clamp_len(l, s.size()), cs(c));
@@ -117,13 +109,13 @@ void s_find(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
   std::string s = cs(b);
   std::string t = cs(c);
   auto pos = t.empty() ? std::string::npos : s.find(t);
-  st<int16_t>(a, pos == std::string::npos ? int16_t(0) : static_cast<int16_t>(pos + 1));
+  store_as<int16_t>(a, pos == std::string::npos ? int16_t(0) : static_cast<int16_t>(pos + 1));
 }
 
-void i64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(ld<int64_t>(b))); }
-void u64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(ld<uint64_t>(b))); }
-void f32_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", ld<float>(b))); }
-void f64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", ld<double>(b))); }
+void i64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(load_as<int64_t>(b))); }
+void u64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(load_as<uint64_t>(b))); }
+void f32_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", load_as<float>(b))); }
+void f64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", load_as<double>(b))); }
 void bool_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, *b ? "TRUE" : "FALSE"); }
 
 std::string duration_text(int64_t ns) {
@@ -176,23 +168,23 @@ std::string tod_part(int64_t ns) {
   if (ms) out += fmt::format(".{:03}", ms);
   return out;
 }
-void time_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, duration_text(ld<int64_t>(b))); }
-void date_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "D#" + date_part(ld<int64_t>(b))); }
-void tod_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "TOD#" + tod_part(ld<int64_t>(b))); }
+void time_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, duration_text(load_as<int64_t>(b))); }
+void date_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "D#" + date_part(load_as<int64_t>(b))); }
+void tod_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "TOD#" + tod_part(load_as<int64_t>(b))); }
 void dt_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  int64_t v = ld<int64_t>(b);
+  int64_t v = load_as<int64_t>(b);
   put(a, cap, "DT#" + date_part(v) + "-" + tod_part(v));
 }
 
 // Text to numbers: leading/trailing blanks allowed, garbage yields 0 (as PLC runtimes do).
 void s_to_i64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  st<int64_t>(a, std::strtoll(cs(b), nullptr, 10));
+  store_as<int64_t>(a, std::strtoll(cs(b), nullptr, 10));
 }
 void s_to_u64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  st<uint64_t>(a, std::strtoull(cs(b), nullptr, 10));
+  store_as<uint64_t>(a, std::strtoull(cs(b), nullptr, 10));
 }
 void s_to_f64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  st<double>(a, std::strtod(cs(b), nullptr));
+  store_as<double>(a, std::strtod(cs(b), nullptr));
 }
 void s_to_bool(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
   std::string s = cs(b);
@@ -201,14 +193,14 @@ void s_to_bool(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
 }
 void s_to_time(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
   // Accepts plain milliseconds ("1500") as CODESYS's STRING_TO_TIME does for bare numbers.
-  st<int64_t>(a, std::strtoll(cs(b), nullptr, 10) * 1'000'000);
+  store_as<int64_t>(a, std::strtoll(cs(b), nullptr, 10) * 1'000'000);
 }
 void dt_to_date(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  st<int64_t>(a, floor_div(ld<int64_t>(b), kDayNs) * kDayNs);
+  store_as<int64_t>(a, floor_div(load_as<int64_t>(b), kDayNs) * kDayNs);
 }
 void dt_to_tod(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  int64_t v = ld<int64_t>(b);
-  st<int64_t>(a, v - floor_div(v, kDayNs) * kDayNs);
+  int64_t v = load_as<int64_t>(b);
+  store_as<int64_t>(a, v - floor_div(v, kDayNs) * kDayNs);
 }
 
 struct Entry {
