@@ -47,7 +47,9 @@ bool ok_all(const std::vector<Val>& vals) {
 }
 
 // The REAL type math on t computes in: REAL for REAL, LREAL for anything else.
-const Type* real_of(Compiler& cc, const Type* t) { return t && t->kind == TypeKind::Real ? t : cc.elem(TypeKind::LReal); }
+const Type* real_of(Compiler& cc, const Type* t) {
+  return t && t->kind == TypeKind::Real ? t : cc.elem(TypeKind::LReal);
+}
 
 // A string function's STRING operand.
 std::optional<Slot> str_arg(Compiler& cc, const Expr* e, std::string_view fn) {
@@ -157,8 +159,9 @@ std::vector<const Expr*> Compiler::positional(const CallExpr& c, size_t min, siz
       if (a.name && idx == SIZE_MAX) {
         // IN0, IN1, ... for the variadic functions.
         std::string n = canon(a.name->text);
+        bool after_k = names && names->size() && iequals((*names)[0], "K");  // MUX: K comes first
         if (n.size() > 2 && n.rfind("IN", 0) == 0 && std::all_of(n.begin() + 2, n.end(), ::isdigit))
-          idx = static_cast<size_t>(std::stoul(n.substr(2))) + (names && names->size() && iequals((*names)[0], "K") ? 1 : 0);
+          idx = static_cast<size_t>(std::stoul(n.substr(2))) + (after_k ? 1 : 0);
         else if (n == "IN") idx = 0;
       }
       if (idx == SIZE_MAX) {
@@ -177,9 +180,11 @@ std::vector<const Expr*> Compiler::positional(const CallExpr& c, size_t min, siz
     for (const auto& a : c.args) out.push_back(a.value.get());
   }
   if (out.size() < min || out.size() > max) {
-    diags_.error("ST210", c.loc, std::string(name) + " takes " +
-                                     (min == max ? std::to_string(min) : std::to_string(min) + (max == SIZE_MAX ? " or more" : " to " + std::to_string(max))) +
-                                     " argument(s), not " + std::to_string(out.size()));
+    std::string count = min == max        ? std::to_string(min)
+                        : max == SIZE_MAX ? std::to_string(min) + " or more"
+                                          : std::to_string(min) + " to " + std::to_string(max);
+    diags_.error("ST210", c.loc,
+                 std::string(name) + " takes " + count + " argument(s), not " + std::to_string(out.size()));
     return {};
   }
   for (const Expr* e : out)
@@ -297,7 +302,10 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
         emit(num_op(Op::NE_I8, from->storage()), {t, s, konst(from, ConstV{ConstV::K::Real, 0, 0.0, {}}, c.loc)});
         return slot_val(to, t);
       }
-      Op op = from->size == 1 ? Op::TOBOOL8 : from->size == 2 ? Op::TOBOOL16 : from->size == 4 ? Op::TOBOOL32 : Op::TOBOOL64;
+      Op op = from->size == 1   ? Op::TOBOOL8
+              : from->size == 2 ? Op::TOBOOL16
+              : from->size == 4 ? Op::TOBOOL32
+                                : Op::TOBOOL64;
       emit(op, {t, s});
       def(t);
       return slot_val(to, t);
@@ -544,7 +552,10 @@ std::optional<Val> Compiler::emit_shift(const StdFunc& f, const CallExpr& c) {
   }
   Slot a = to_slot(v, t, args[0]->loc);
   Slot b = n.is_const ? konst(elem(TypeKind::ULInt), n.c, args[1]->loc) : convert(n.slot, nt, elem(TypeKind::ULInt));
-  Op base = f.shift == Shift::Shl ? Op::SHL_I8 : f.shift == Shift::Shr ? Op::SHR_I8 : f.shift == Shift::Rol ? Op::ROL_I8 : Op::ROR_I8;
+  Op base = f.shift == Shift::Shl   ? Op::SHL_I8
+            : f.shift == Shift::Shr ? Op::SHR_I8
+            : f.shift == Shift::Rol ? Op::ROL_I8
+                                    : Op::ROR_I8;
   Slot d = temp_for(t);
   emit(int_op(base, t->storage()), {d, a, b});
   def(d);
@@ -648,7 +659,8 @@ std::optional<Val> Compiler::emit_temporal(const StdFunc& f, const CallExpr& c) 
     Val t = expr(*args[0]);
     if (!t.ok) return bad();
     if (!t.type || (t.type->kind != TypeKind::Time && t.type->kind != TypeKind::LTime)) {
-      diags_.error("ST203", args[0]->loc, "PASSED needs a duration such as T#2s, not " + (t.type ? t.type->name : std::string("a number")));
+      diags_.error("ST203", args[0]->loc,
+                   "PASSED needs a duration such as T#2s, not " + (t.type ? t.type->name : std::string("a number")));
       return bad();
     }
     Val e;
@@ -662,7 +674,8 @@ std::optional<Val> Compiler::emit_temporal(const StdFunc& f, const CallExpr& c) 
   if (!v.ok) return bad();
   const Type* t = v.type ? v.type : default_type(v.c);
   if (!edge && !is_change_operand(t)) {
-    diags_.error("ST203", args[0]->loc, name + " needs a number, bit string, time or enumeration value, not " + t->name);
+    diags_.error("ST203", args[0]->loc,
+                 name + " needs a number, bit string, time or enumeration value, not " + t->name);
     return bad();
   }
   if (!edge && f.temporal != Temporal::Changes && !is_ordered_operand(t)) {
@@ -787,8 +800,8 @@ std::optional<Val> Compiler::emit_assert(const StdFunc& f, const CallExpr& c) {
   if (vals[0].type && vals[1].type && vals[0].type->kind == TypeKind::Enum && vals[0].type != vals[1].type) t = nullptr;
   if (vals[0].type && vals[1].type && vals[0].type->is_string() && vals[1].type->is_string()) t = vals[0].type;
   if (!t) {
-    diags_.error("ST203", c.loc, name + ": cannot compare " + (vals[0].type ? vals[0].type->name : std::string("a literal")) + " with " +
-                                     (vals[1].type ? vals[1].type->name : std::string("a literal")));
+    auto what = [](const Val& v) { return v.type ? v.type->name : std::string("a literal"); };
+    diags_.error("ST203", c.loc, name + ": cannot compare " + what(vals[0]) + " with " + what(vals[1]));
     return bad();
   }
   Val c0 = coerce(vals[0], t, args[0]->loc, name.c_str());

@@ -46,7 +46,8 @@ StdFunc shift(std::string_view name, Shift s) {
   f.shift = s;
   return f;
 }
-StdFunc string(std::string_view name, Native n, const char* operands, bool int_result, std::vector<const char*> params) {
+StdFunc string(std::string_view name, Native n, const char* operands, bool int_result,
+               std::vector<const char*> params) {
   auto count = static_cast<uint8_t>(std::string_view(operands).size());
   StdFunc f = fn(name, StdFamily::String, count, count, 0, std::move(params));
   f.native = n;

@@ -124,8 +124,8 @@ TEST_F(Conversions, NamesParseToTheirTypes) {
 }
 
 TEST_F(Conversions, OtherNamesAreNoConversion) {
-  for (std::string_view n : {"FOO_TO_INT", "INT_TO_FOO", "TO_", "TO_FOO", "SQRT", "REAL_TRUNC_INT", "TRUNC_INT", "ADD_TIME",
-                             "CONCAT_DATE_TOD", "SUB_TOD_TOD", ""})
+  for (std::string_view n : {"FOO_TO_INT", "INT_TO_FOO", "TO_", "TO_FOO", "SQRT", "REAL_TRUNC_INT", "TRUNC_INT",
+                             "ADD_TIME", "CONCAT_DATE_TOD", "SUB_TOD_TOD", ""})
     EXPECT_EQ(parsed(n), "none") << n;
 }
 
