@@ -1,5 +1,6 @@
 // Internal state of the ST compiler, shared by its translation units (declarations,
-// expressions, places, statements, calls). Not part of the engine's public interface.
+// expressions, places, statements, calls, standard functions). Not part of the
+// engine's public interface.
 //
 // The compiler works in two stages over the AST: declarations (types, POU signatures,
 // layouts, globals) are indexed first; then each POU body is type-checked and translated
@@ -12,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -19,6 +21,11 @@
 #include "codegen/compiler.hpp"
 #include "vm/natives.hpp"
 #include "vm/vm.hpp"
+
+namespace plcfi::st {
+struct StdFunc;
+struct ConversionName;
+}  // namespace plcfi::st
 
 namespace plcfi::st::detail {
 
@@ -210,7 +217,6 @@ class Compiler {
   Slot konst_i64(int64_t v);
   Slot konst_u32(uint32_t v);
   Slot hidden(uint32_t size, uint32_t align);
-  std::optional<Val> temporal(const std::string& name, const CallExpr& c);
 
   // ---- statements (stmt.cpp)
   void stmts(const StmtList& list);
@@ -266,20 +272,43 @@ class Compiler {
   Slot addr_of(const Place& p, SourceLoc loc);
   const Symbol* lookup(const std::string& canon_name) const;
 
-  // ---- calls (calls.cpp)
+  // ---- calls of user code (calls.cpp)
   Val call(const CallExpr& c, bool as_statement);
   bool may_call(const Expr& e) const;
   Val call_function(PouInfo* f, const CallExpr& c);
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
-  std::optional<Val> builtin(const std::string& name, const CallExpr& c);
-  const Type* call_expected_ = nullptr;  // the type the context expects of the call being compiled
-  std::optional<Val> conversion(const std::string& name, const CallExpr& c);
   Val property_get(const Place& inst, PouInfo* getter, Slot this_ptr, SourceLoc loc);
   void property_set(PouInfo* setter, Slot this_ptr, const Val& v, SourceLoc loc);
-  std::vector<const Expr*> positional(const CallExpr& c, size_t min, size_t max, const char* name);
+  const Type* call_expected_ = nullptr;  // the type the context expects of the call being compiled
+
+  // ---- standard functions, conversions, test built-ins (builtins.cpp); signatures in sema/stdfuncs
+  // A call of the standard function `name` (canonical), or nullopt when there is none.
+  std::optional<Val> builtin(const std::string& name, const CallExpr& c);
+  std::optional<Val> conversion(const std::string& name, const ConversionName& conv, const CallExpr& c);
+  std::vector<const Expr*> positional(const CallExpr& c, size_t min, size_t max, std::string_view name);
+  std::vector<const Expr*> positional(const CallExpr& c, const StdFunc& f);  // f's argument counts
   Val native(Native n, const Type* result, std::initializer_list<Slot> args, uint32_t cap = 0);
   Val native_list(Native n, const Type* result, const std::vector<Slot>& args, uint32_t cap = 0);
+  // One emitter per StdFamily (SEL and MUX share one).
+  std::optional<Val> emit_math(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_expt(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_abs(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_extremum(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_select(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_operator(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_concat_date_tod(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_move(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_shift(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_string(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_concat(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_replace(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_address_of(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_sizeof(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_now(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_temporal(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_advance_time(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_assert(const StdFunc& f, const CallExpr& c);
 
   // ---- side tables: the compiler's knowledge of the syntax tree, kept out of the program
   PouSource& src(const PouInfo* p) { return pou_src_[p]; }
