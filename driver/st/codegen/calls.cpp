@@ -363,6 +363,13 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     }
     out_vals.push_back(v);
   }
+  store_outputs(outs, out_vals);
+  return none;
+}
+
+// The `x => v` and `NOT x => v` arguments of a call, in order, from the output values
+// read out of the callee's frame after the call (one per output, invalid where unused).
+void Compiler::store_outputs(const std::vector<std::pair<Symbol*, const CallArg*>>& outs, const std::vector<Val>& out_vals) {
   for (size_t k = 0; k < outs.size(); ++k) {
     const CallArg* a = outs[k].second;
     if (!a->value) continue;
@@ -374,7 +381,6 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     }
     assign(place(*a->value, true), v, a->loc);
   }
-  return none;
 }
 
 // ------------------------------------------------------------------ methods
@@ -528,17 +534,7 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
   if (m->result && m->result->kind != TypeKind::Void) r = load(frame_field(m->result_offset, m->result));
   std::vector<Val> out_vals;
   for (auto [o, a] : outs) out_vals.push_back(a->value ? load(frame_field(o->offset, o->type)) : Val{});
-  for (size_t k = 0; k < outs.size(); ++k) {
-    const CallArg* a = outs[k].second;
-    if (!a->value) continue;
-    Val v = out_vals[k];
-    if (a->negate) {
-      Slot t = temp(1, 1);
-      emit(Op::BNOT, {t, v.slot});
-      v.slot = t;
-    }
-    assign(place(*a->value, true), v, a->loc);
-  }
+  store_outputs(outs, out_vals);
   return r;
 }
 

@@ -278,6 +278,7 @@ class Compiler {
   Val call_function(PouInfo* f, const CallExpr& c);
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
+  void store_outputs(const std::vector<std::pair<Symbol*, const CallArg*>>& outs, const std::vector<Val>& out_vals);
   Val property_get(const Place& inst, PouInfo* getter, Slot this_ptr, SourceLoc loc);
   void property_set(PouInfo* setter, Slot this_ptr, const Val& v, SourceLoc loc);
   const Type* call_expected_ = nullptr;  // the type the context expects of the call being compiled
