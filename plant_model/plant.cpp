@@ -1,6 +1,7 @@
 // Plant factory: maps a plant name and an optional parameter file to a plant model.
 #include "plant_model/plant.hpp"
 
+#include "plant_model/bead_dispenser/bead_dispenser.hpp"
 #include "plant_model/stamping/stamping_plant.hpp"
 
 namespace plcfi::plant {
@@ -11,6 +12,11 @@ std::unique_ptr<Plant> make_plant(const std::string& name, const std::string& co
     if (!config_path.empty() && !load_stamping_params(config_path, &params, err)) return nullptr;
     return std::make_unique<StampingPlant>(std::move(params));
   }
+  if (name == "bead_dispenser") {
+    BeadParams params;
+    if (!config_path.empty() && !load_bead_params(config_path, &params, err)) return nullptr;
+    return std::make_unique<BeadDispenserPlant>(params);
+  }
   if (err) {
     std::string known;
     for (const auto& n : plant_names()) known += (known.empty() ? "" : ", ") + n;
@@ -19,6 +25,6 @@ std::unique_ptr<Plant> make_plant(const std::string& name, const std::string& co
   return nullptr;
 }
 
-std::vector<std::string> plant_names() { return {"stamping"}; }
+std::vector<std::string> plant_names() { return {"stamping", "bead_dispenser"}; }
 
 }  // namespace plcfi::plant

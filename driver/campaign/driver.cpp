@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "common/file.hpp"
+#include "common/hash.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "journal.hpp"
 #include "plant_model/plant.hpp"
@@ -24,11 +25,8 @@
 namespace plcfi::campaign {
 
 std::string campaign_fingerprint(const CampaignBuild& cb) {
-  uint64_t h = 1469598103934665603ull;
-  auto mix = [&](const std::string& s) {
-    for (unsigned char ch : s) h = (h ^ ch) * 1099511628211ull;
-    h = (h ^ 0xff) * 1099511628211ull;
-  };
+  common::Fnv64 h;
+  auto mix = [&](const std::string& s) { h.add(s); };
   mix(cb.spec.name);
   mix(std::to_string(cb.spec.seed));
   mix(std::to_string(cb.spec.max_paths));
@@ -48,7 +46,7 @@ std::string campaign_fingerprint(const CampaignBuild& cb) {
     mix(c.target->bind);
     mix(std::to_string(c.deadline_ns));
   }
-  return fmt::format("{:016x}", h);
+  return h.hex();
 }
 
 std::vector<std::string> distinguishing_branches(const CampaignBuild& cb, const std::vector<Execution>& all,

@@ -24,6 +24,10 @@ class IoBackend {
   // Back to the initial state (a simulated plant resets its physics; real I/O: nothing).
   virtual void reset(uint64_t seed) = 0;
   virtual const std::string& last_error() const = 0;
+  // Exchanges that failed or had to be repeated since the backend was made (a lost or
+  // late reply, a broken link): the communication-error indicator of test scripts.
+  // Backends that cannot fail (a simulated plant) count none.
+  virtual uint64_t failed_exchanges() const { return 0; }
 };
 
 }  // namespace plcfi::rt

@@ -474,7 +474,8 @@ bool write_text(Machine& m, const VarHandle& h, std::string_view text, std::stri
     write_int(m, h, neg ? -l.time_ns : l.time_ns);
     return true;
   }
-  if (l.lit != LiteralKind::Int && l.lit != LiteralKind::Bool) return bad_kind();
+  // TRUE/FALSE fit a bit string (a BYTE of one bit), not an integer: INT := TRUE is a type error.
+  if (l.lit != LiteralKind::Int && !(l.lit == LiteralKind::Bool && t->is_bitstring())) return bad_kind();
   int64_t v = neg ? -static_cast<int64_t>(l.int_value) : static_cast<int64_t>(l.int_value);
   // Range check against the type.
   int64_t lo = 0, hi = 0;

@@ -28,6 +28,11 @@ class BenchIo final : public rt::IoBackend {
   bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) override;
   void reset(uint64_t seed) override;
   const std::string& last_error() const override { return error_; }
+  uint64_t failed_exchanges() const override {
+    uint64_t n = 0;
+    for (const auto* p : parts_) n += p->failed_exchanges();
+    return n;
+  }
 
   // "" or the lost device's last error (down longer than its lost_after).
   std::string lost() const;

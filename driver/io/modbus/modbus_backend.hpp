@@ -44,6 +44,13 @@ class ModbusBackend final : public rt::IoBackend {
   const std::string& last_error() const override { return error_; }
 
   const std::vector<DeviceStats>& stats() const { return stats_; }
+  // Failed requests of every device (a timeout, a refused or broken connection, a short
+  // or wrong answer).
+  uint64_t failed_exchanges() const override {
+    uint64_t n = 0;
+    for (const auto& s : stats_) n += s.failures;
+    return n;
+  }
   // The device that has been down longer than its lost_after, on the monotonic clock
   // (SIZE_MAX: none).
   size_t lost_device() const;

@@ -583,7 +583,7 @@ TEST_F(PlantStampingYaml, DefaultsWithoutFile) {
   EXPECT_EQ(p.operator_press_time, 0.2);
   EXPECT_TRUE(p.operator_ack_at.empty());
   EXPECT_TRUE(p.operator_jogs.empty());
-  EXPECT_EQ(plant_names(), std::vector<std::string>{"stamping"});
+  EXPECT_EQ(plant_names(), (std::vector<std::string>{"stamping", "bead_dispenser"}));
 }
 
 TEST_F(PlantStampingYaml, DocumentedFileIsTheDefaults) {
@@ -730,7 +730,7 @@ TEST_F(PlantStampingYaml, SyntaxErrorMissingFileUnknownPlant) {
   EXPECT_EQ(err, dir_.string() + ": is a directory");
 
   EXPECT_EQ(make_plant("press", "", &err), nullptr);
-  EXPECT_EQ(err, "unknown plant 'press' (known: stamping)");
+  EXPECT_EQ(err, "unknown plant 'press' (known: stamping, bead_dispenser)");
 }
 
 }  // namespace

@@ -1,0 +1,366 @@
+// plcfi script: CPTest+ test scripts against a PLC program on a plant model in virtual
+// time, with ASSERT_COM, link faults, the undecidable verdict and the run history;
+// plcfi history: that history, newest first.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "engine.hpp"
+#include "io/link_fault.hpp"
+#include "io/sim/sim_backend.hpp"
+#include "options.hpp"
+#include "plant_model/plant.hpp"
+#include "report/junit.hpp"
+#include "runtime/realtime.hpp"
+#include "runtime/schedule.hpp"
+#include "script/bind.hpp"
+#include "script/cpt.hpp"
+#include "script/history.hpp"
+#include "script/runner.hpp"
+
+namespace po = boost::program_options;
+
+namespace plcfi::cli {
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  if (s.size() < suffix.size()) return false;
+  for (size_t i = 0; i < suffix.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(s[s.size() - suffix.size() + i])) != suffix[i]) return false;
+  return true;
+}
+
+std::string secs(int64_t ns) { return fmt::format("{:.3f}", static_cast<double>(ns) * 1e-9); }
+
+// "Undecidable", "Passed", "Failed": the words of the published history table.
+std::string title(const std::string& verdict) {
+  std::string t = verdict;
+  if (!t.empty()) t[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(t[0])));
+  return t;
+}
+
+// The log of a run as text: every command, LOG line and snapshot, with the scan clock.
+bool write_text_log(const std::string& path, const script::ScriptResult& r, std::string* err) {
+  std::ofstream o(path);
+  if (!o) {
+    *err = path + ": cannot write";
+    return false;
+  }
+  o << fmt::format("# {}: {}{}\n", r.test, script::verdict_name(r.verdict), r.reason.empty() ? "" : " (" + r.reason + ")");
+  for (const auto& e : r.log) {
+    std::string line = e.line ? fmt::format("line {:>3}", e.line) : std::string(8, ' ');
+    const char* kind = e.kind == script::LogEntry::Kind::Command    ? "CMD "
+                       : e.kind == script::LogEntry::Kind::Log      ? "LOG "
+                       : e.kind == script::LogEntry::Kind::Snapshot ? "SNAP"
+                                                                    : "END ";
+    o << fmt::format("{:>10} s  scan {:>7}  {}  {}  {}\n", secs(e.t_ns), e.scan, line, kind, e.text);
+    if (e.snapshot >= 0)
+      for (size_t i = 0; i < r.snapshot_paths.size(); ++i)
+        o << "      " << r.snapshot_paths[i] << " = " << r.snapshots[static_cast<size_t>(e.snapshot)][i] << "\n";
+  }
+  if (!o) {
+    *err = path + ": write error";
+    return false;
+  }
+  return true;
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+// The snapshots as CSV, one row each, to plot the variables around a failed assertion.
+bool write_csv_log(const std::string& path, const script::ScriptResult& r, std::string* err) {
+  std::ofstream o(path);
+  if (!o) {
+    *err = path + ": cannot write";
+    return false;
+  }
+  o << "time,scan,line,event";
+  for (const auto& p : r.snapshot_paths) o << "," << csv_field(p);
+  o << "\n";
+  for (const auto& e : r.log) {
+    if (e.snapshot < 0) continue;
+    o << secs(e.t_ns) << "," << e.scan << "," << e.line << "," << csv_field(e.text);
+    for (const auto& v : r.snapshots[static_cast<size_t>(e.snapshot)]) o << "," << csv_field(v);
+    o << "\n";
+  }
+  if (!o) {
+    *err = path + ": write error";
+    return false;
+  }
+  return true;
+}
+
+double number_option(const po::variables_map& vm, const char* key) { return vm[key].as<double>(); }
+
+}  // namespace
+
+int cmd_script(const std::vector<std::string>& args) {
+  const std::string usage =
+      "plcfi script PROGRAM.st... TEST.cpt... [--plant stamping|bead_dispenser] [--history FILE] [--log DIR] "
+      "[--junit F] [--link-fault AT:FOR] [--max-wait 1s] [--alpha A --beta B --gamma G --psi P --n N]";
+  po::options_description desc("plcfi script: CPTest+ test scripts against a PLC program and a plant model, in virtual time");
+  desc.add_options()
+      ("plant", po::value<std::string>()->default_value("stamping"), "plant model (stamping, bead_dispenser)")
+      ("plant-config", po::value<std::string>(), "plant parameters (YAML)")
+      ("seed", po::value<Count>()->default_value(Count{1}, "1"), "seed of the plant's random variation")
+      ("cycle-time", po::value<std::string>()->default_value("10ms"), "cycle time when the program has no CONFIGURATION")
+      ("history", po::value<std::string>(), "run history (SQLite; default $PLCFI_HISTORY or ~/.local/state/plcfi/history.sqlite)")
+      ("log", po::value<std::string>(), "folder for each run's log: TEST.log (text) and TEST.csv (snapshots)")
+      ("junit", po::value<std::string>(), "write JUnit XML (undecidable: skipped, with m_ci)")
+      ("link-fault", po::value<std::string>(), "break the link to the plant in every run: AT:FOR, e.g. 100ms:300ms")
+      ("link-status", po::value<std::string>(), "an %IX bit that reads TRUE while the link to the plant works")
+      ("max-wait", po::value<std::string>()->default_value("1s"), "how long ASSERT_COM re-checks through a communication error")
+      ("alpha", po::value<double>()->default_value(0.1, "0.1"), "m_ci: least value in the middle band")
+      ("beta", po::value<double>()->default_value(0.9, "0.9"), "m_ci: greatest value in the middle band")
+      ("gamma", po::value<IntIn<2, 1000000>>()->default_value(IntIn<2, 1000000>{10}, "10"), "m_ci: cycles taken into account")
+      ("psi", po::value<IntIn<1, 1000000>>()->default_value(IntIn<1, 1000000>{10}, "10"), "m_ci: latest runs counted for p_lst")
+      ("n", po::value<double>()->default_value(1.0, "1"), "m_ci: shape of the fall from beta to alpha (1: linear)")
+      ("native", "run the program through the native tier");
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm, usage)) return 0;
+  std::vector<std::string> programs, scripts;
+  for (const auto& f : strings_of(vm, "files")) (ends_with(f, ".cpt") ? scripts : programs).push_back(f);
+  if (programs.empty() || scripts.empty()) {
+    std::cerr << "plcfi script: expected the program's ST files and one or more .cpt scripts\nusage: " << usage << "\n";
+    return 2;
+  }
+  std::string err;
+  script::RunOptions ro;
+  ro.mci.alpha = number_option(vm, "alpha");
+  ro.mci.beta = number_option(vm, "beta");
+  ro.mci.gamma = vm["gamma"].as<IntIn<2, 1000000>>().value;
+  ro.mci.psi = vm["psi"].as<IntIn<1, 1000000>>().value;
+  ro.mci.n = number_option(vm, "n");
+  if (std::string e = script::check_params(ro.mci); !e.empty()) {
+    std::cerr << "plcfi script: " << e << "\n";
+    return 2;
+  }
+  if (!rt::parse_duration(vm["max-wait"].as<std::string>(), &ro.max_wait_ns, &err)) {
+    std::cerr << "plcfi script: --max-wait: " << err << "\n";
+    return 2;
+  }
+  int64_t fault_at = -1, fault_for = 0;
+  if (vm.count("link-fault")) {
+    const std::string v = vm["link-fault"].as<std::string>();
+    size_t colon = v.find(':');
+    if (colon == std::string::npos || !rt::parse_duration(v.substr(0, colon), &fault_at, &err) ||
+        !rt::parse_duration(v.substr(colon + 1), &fault_for, &err) || fault_for <= 0) {
+      std::cerr << "plcfi script: --link-fault: expected AT:FOR with two durations, e.g. 100ms:300ms" << (err.empty() ? "" : " (" + err + ")")
+                << ", got '" << v << "'\n";
+      return 2;
+    }
+  }
+
+  // Everything is read and checked before anything runs.
+  st::CompileOptions opt;
+  opt.warnings = false;
+  auto b = st::build_files(programs, opt);
+  for (const auto& e : b->io_errors) std::cerr << e << "\n";
+  std::cerr << b->diags.render_all();
+  if (!b->ok()) return 2;
+  const st::Application& app = *b->app;
+  std::vector<script::Script> parsed(scripts.size());
+  std::vector<script::BoundScript> bound(scripts.size());
+  const std::vector<std::string> devices = {"plant"};
+  for (size_t i = 0; i < scripts.size(); ++i) {
+    if (!script::load_script(scripts[i], &parsed[i], &err) || !script::bind_script(app, parsed[i], devices, &bound[i], &err)) {
+      std::cerr << err << "\n";
+      return 2;
+    }
+  }
+  int64_t cycle = 0;
+  if (!rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
+    std::cerr << "plcfi script: --cycle-time: " << err << "\n";
+    return 2;
+  }
+  rt::Schedule sched;
+  if (!(app.has_configuration ? sched.from_configuration(app, &err) : sched.single_program(app, "", cycle, &err))) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return 2;
+  }
+  auto plant = plant::make_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
+  if (!plant) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return 2;
+  }
+  const std::string plant_name = plant->name();
+  auto sim = io::SimBackend::create(app, std::move(plant), &err);
+  if (!sim) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return 2;
+  }
+  std::optional<rt::ImageRef> status;
+  if (vm.count("link-status")) {
+    rt::ImageRef ref;
+    if (!rt::parse_image_ref(app, vm["link-status"].as<std::string>(), &ref, &err) || ref.area != 'I' || !ref.is_bit) {
+      std::cerr << "plcfi script: --link-status: " << (err.empty() ? "expected an input bit such as %IX1.0" : err) << "\n";
+      return 2;
+    }
+    status = ref;
+  }
+  io::LinkFaultBackend link(sim.get(), "plant", status);
+  ro.link = &link;
+  rt::Runtime runtime(app, sched, &link);
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(app, "plcfi script"))) return 2;
+  runtime.machine().set_native(native.get());
+  const std::string history_path = vm.count("history") ? vm["history"].as<std::string>() : script::default_history_path();
+  auto history = script::History::open(history_path, &err);
+  if (!history) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return 2;
+  }
+  std::string log_dir = vm.count("log") ? vm["log"].as<std::string>() : "";
+  if (!log_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(log_dir, ec);
+    if (ec) {
+      std::cerr << "plcfi script: --log: " << log_dir << ": " << ec.message() << "\n";
+      return 2;
+    }
+  }
+
+  rt::StopSignals signals;
+  ro.signals = &signals;
+  const std::string prog_hash = script::program_hash(*b);
+  const uint64_t seed = vm["seed"].as<Count>().value;
+  report::JunitSuite suite;
+  suite.name = "plcfi script";
+  suite.properties = {{"plant", plant_name}, {"history", history_path}};
+  int failed = 0, undecidable = 0, passed = 0;
+  std::cout << fmt::format("plcfi script: {} on plant {}, history {}\n", programs.front(), plant_name, history_path);
+  for (size_t i = 0; i < bound.size(); ++i) {
+    const script::Script& s = parsed[i];
+    std::vector<std::string> pous;
+    const std::string pou_hash = script::involved_pous_hash(*b, bound[i].var_paths, &pous);
+    if (!history->passes_since_change(s.name, pou_hash, ro.mci.psi, &ro.p_lst, &err)) {
+      std::cerr << "plcfi script: " << err << "\n";
+      return 2;
+    }
+    runtime.cold_restart(seed);
+    if (fault_at >= 0) link.break_link(runtime.now() + fault_at, fault_for);
+    script::ScriptResult r = script::run_script(runtime, bound[i], ro);
+    std::string pou_list;
+    for (const auto& p : pous) pou_list += (pou_list.empty() ? "" : ", ") + p;
+    std::cout << fmt::format("\n[{}] {}  ({} s on the scan clock, {} scans; POUs {}; p_lst {} of the latest {})\n", s.path,
+                             title(script::verdict_name(r.verdict)), secs(r.end_ns), r.scans, pou_list.empty() ? "none" : pou_list,
+                             ro.p_lst, ro.mci.psi);
+    bool waited = false;
+    for (const auto& a : r.asserts)
+      if (a.waited) {
+        waited = true;
+        std::cout << fmt::format("  {}: {}: waited {} cycle(s) through a communication error, {}; c = {}, m_ci = {:.3g}\n",
+                                 a.where, a.text, a.held ? a.cycles : a.cycles - 1, a.held ? "then it held" : "it never held",
+                                 a.cycles, a.mci);
+      }
+    if (!r.reason.empty() && !waited) std::cout << "  " << r.reason << "\n";
+    if (r.verdict == script::Verdict::Undecidable && !r.asserts.empty() && r.asserts.back().has_mci)
+      std::cout << fmt::format("  possible external problem, factor = {:.3g}\n", r.asserts.back().mci);
+    if (link.lost() > 0) std::cout << fmt::format("  link to the plant: {} exchange(s) lost (fault injected)\n", link.lost());
+
+    script::HistoryRow row;
+    row.test = s.name;
+    row.verdict = script::verdict_name(r.verdict);
+    row.time = script::utc_now();
+    for (const auto& a : r.asserts)
+      if (a.has_mci) {
+        row.mci = a.mci;
+        row.cycles = a.cycles;
+      }
+    row.program_hash = prog_hash;
+    row.pou_hash = pou_hash;
+    row.reason = r.reason;
+    if (!history->add(row, &err)) {
+      std::cerr << "plcfi script: " << err << "\n";
+      return 2;
+    }
+    if (!log_dir.empty()) {
+      if (!write_text_log(log_dir + "/" + s.name + ".log", r, &err) || !write_csv_log(log_dir + "/" + s.name + ".csv", r, &err)) {
+        std::cerr << "plcfi script: --log: " << err << "\n";
+        return 2;
+      }
+    }
+    report::JunitCase jc;
+    jc.classname = "script";
+    jc.name = s.name;
+    jc.seconds = static_cast<double>(r.end_ns) * 1e-9;
+    if (r.verdict == script::Verdict::Failed) {
+      jc.outcome = report::JunitCase::Outcome::Fail;
+      jc.message = r.reason;
+      ++failed;
+    } else if (r.verdict == script::Verdict::Undecidable) {
+      // Neither a pass nor a failure of the program.
+      jc.outcome = report::JunitCase::Outcome::Skipped;
+      jc.message = "undecidable: " + r.reason;
+      if (row.mci) jc.properties.emplace_back("m_ci", fmt::format("{:.3g}", *row.mci));
+      ++undecidable;
+    } else {
+      ++passed;
+    }
+    jc.properties.emplace_back("verdict", row.verdict);
+    jc.properties.emplace_back("p_lst", std::to_string(ro.p_lst));
+    suite.cases.push_back(jc);
+    if (signals.requested()) break;
+  }
+  std::cout << fmt::format("\n{} passed, {} failed, {} undecidable\n", passed, failed, undecidable);
+  if (vm.count("junit") && !report::write_junit(vm["junit"].as<std::string>(), {suite}, &err)) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return 2;
+  }
+  return failed > 0 ? 1 : 0;
+}
+
+int cmd_history(const std::vector<std::string>& args) {
+  const std::string usage = "plcfi history [TEST] [--history FILE] [--last N]";
+  po::options_description desc("plcfi history: the run history of test scripts, newest first");
+  desc.add_options()
+      ("history", po::value<std::string>(), "run history (default $PLCFI_HISTORY or ~/.local/state/plcfi/history.sqlite)")
+      ("last", po::value<Count>()->default_value(Count{50}, "50"), "at most this many runs (0: all)");
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm, usage, "test")) return 0;
+  auto tests = strings_of(vm, "test");
+  if (tests.size() > 1) {
+    std::cerr << "plcfi history: at most one test name\nusage: " << usage << "\n";
+    return 2;
+  }
+  std::string err;
+  const std::string path = vm.count("history") ? vm["history"].as<std::string>() : script::default_history_path();
+  if (!std::filesystem::exists(path)) {
+    std::cerr << "plcfi history: " << path << ": no history yet (plcfi script writes it)\n";
+    return 2;
+  }
+  auto h = script::History::open(path, &err);
+  std::vector<script::HistoryRow> rows;
+  if (!h || !h->list(tests.empty() ? "" : tests[0], vm["last"].as<Count>().value, &rows, &err)) {
+    std::cerr << "plcfi history: " << err << "\n";
+    return 2;
+  }
+  if (rows.empty()) {
+    std::cout << (tests.empty() ? std::string("no runs recorded") : "no runs of " + tests[0]) << " in " << path << "\n";
+    return 0;
+  }
+  size_t w = 4;
+  for (const auto& r : rows) w = std::max(w, r.test.size());
+  std::cout << fmt::format("{:<{}}  {:<12} {:<20} {:>6} {:>5}  {}\n", "test", w, "verdict", "time (UTC)", "m_ci", "c", "note");
+  for (const auto& r : rows) {
+    std::string when = r.time;
+    if (when.size() >= 19) when = when.substr(0, 10) + " " + when.substr(11, 8);
+    std::string note = r.verdict == "undecidable" && r.mci ? fmt::format("possible external problem, factor = {:.3g}", *r.mci) : r.reason;
+    std::cout << fmt::format("{:<{}}  {:<12} {:<20} {:>6} {:>5}  {}\n", r.test, w, title(r.verdict), when,
+                             r.mci ? fmt::format("{:.3g}", *r.mci) : "-", r.cycles ? std::to_string(*r.cycles) : "-", note);
+  }
+  return 0;
+}
+
+}  // namespace plcfi::cli
