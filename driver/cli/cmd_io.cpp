@@ -106,13 +106,16 @@ int cmd_plant_server(const std::vector<std::string>& args) {
       ("listen", po::value<std::string>()->default_value("127.0.0.1:1502"), "address and port (HOST:PORT, [V6]:PORT); loopback by default")
       ("tick", po::value<std::string>()->default_value("1ms"), "plant step in real time")
       ("duration", po::value<std::string>(), "stop after this long (default: until SIGINT/SIGTERM)")
-      ("seed", po::value<Count>()->default_value(Count{1}, "1"), "seed of the plant's random variation")
+      ("seed", po::value<Count>()->default_value(Count{1}, "1"), "seed of the plant's random variation (and of --drop-rate)")
+      ("drop-rate", po::value<double>()->default_value(0.0, "0"), "leave this fraction of the requests unanswered (0..1): a lossy link")
+      ("stall", po::value<std::string>(), "answer every request this late (e.g. 10ms; beyond the master's timeout: a failed exchange)")
       ("help,h", "show this help");
   po::variables_map vm;
   po::store(po::command_line_parser(args).options(desc).run(), vm);
   po::notify(vm);
   if (vm.count("help")) {
-    std::cout << "usage: plcfi plant-server [--plant stamping] [--listen 127.0.0.1:1502] [--tick 1ms] [--duration T]\n\n"
+    std::cout << "usage: plcfi plant-server [--plant stamping] [--listen 127.0.0.1:1502] [--tick 1ms] [--duration T] "
+                 "[--drop-rate P] [--stall T]\n\n"
               << desc << "\nRegister map: a sensor on %IXb.i is discrete input 8b+i, on %IWn input register n;\n"
                          "an actuator on %QXb.i is coil 8b+i, on %QWn holding register n (the plant's I/O map).\n";
     return 0;
@@ -156,6 +159,15 @@ int cmd_plant_server(const std::vector<std::string>& args) {
     return 2;
   }
   opt.seed = vm["seed"].as<Count>().value;
+  opt.drop_rate = vm["drop-rate"].as<double>();
+  if (!(opt.drop_rate >= 0.0 && opt.drop_rate <= 1.0)) {
+    std::cerr << "plcfi plant-server: --drop-rate: expected a fraction from 0 to 1, got " << opt.drop_rate << "\n";
+    return 2;
+  }
+  if (vm.count("stall") && (!rt::parse_duration(vm["stall"].as<std::string>(), &opt.stall_ns, &err) || opt.stall_ns > 10'000'000'000)) {
+    std::cerr << "plcfi plant-server: --stall: " << (err.empty() ? "at most 10 s" : err) << "\n";
+    return 2;
+  }
   auto plant = plant::make_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
   if (!plant) {
     std::cerr << "plcfi plant-server: " << err << "\n";
@@ -168,8 +180,11 @@ int cmd_plant_server(const std::vector<std::string>& args) {
               << std::flush;
   };
   bool ok = io::serve_plant(*plant, opt, [&signals] { return signals.requested(); }, &stats, &err, listening);
-  std::cout << fmt::format("plcfi plant-server: {} plant steps ({} late), {} connection(s), {} request(s)\n", stats.steps,
-                           stats.late_steps, stats.connections, stats.requests);
+  std::cout << fmt::format("plcfi plant-server: {} plant steps ({} late), {} connection(s), {} request(s){}\n", stats.steps,
+                           stats.late_steps, stats.connections, stats.requests,
+                           opt.drop_rate > 0 || opt.stall_ns > 0
+                               ? fmt::format(", {} left unanswered, {} answered late", stats.dropped, stats.stalled)
+                               : std::string());
   std::string s;
   for (const auto& [k, v] : plant->stats()) s += fmt::format("{}{} {}", s.empty() ? "" : ", ", k, v);
   std::cout << "  plant " << s << "\n";

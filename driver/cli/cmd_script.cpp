@@ -11,17 +11,21 @@
 
 #include "commands.hpp"
 #include "engine.hpp"
+#include "io/bench/bench_io.hpp"
+#include "io/io_config.hpp"
 #include "io/link_fault.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "options.hpp"
 #include "plant_model/plant.hpp"
 #include "report/junit.hpp"
+#include "report/trace.hpp"
 #include "runtime/realtime.hpp"
 #include "runtime/schedule.hpp"
 #include "script/bind.hpp"
 #include "script/cpt.hpp"
 #include "script/history.hpp"
 #include "script/runner.hpp"
+#include "trace_hook.hpp"
 
 namespace po = boost::program_options;
 
@@ -107,18 +111,21 @@ double number_option(const po::variables_map& vm, const char* key) { return vm[k
 
 int cmd_script(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi script PROGRAM.st... TEST.cpt... [--plant stamping|bead_dispenser] [--history FILE] [--log DIR] "
-      "[--junit F] [--link-fault AT:FOR] [--max-wait 1s] [--alpha A --beta B --gamma G --psi P --n N]";
-  po::options_description desc("plcfi script: CPTest+ test scripts against a PLC program and a plant model, in virtual time");
+      "plcfi script PROGRAM.st... TEST.cpt... [--plant stamping|bead_dispenser | --io FILE] [--realtime] [--history FILE] "
+      "[--log DIR] [--junit F] [--link-fault [DEVICE=]AT:FOR] [--max-wait 1s] [--alpha A --beta B --gamma G --psi P --n N]";
+  po::options_description desc(
+      "plcfi script: CPTest+ test scripts against a PLC program, on a plant model in virtual time or on bench I/O in real time");
   desc.add_options()
-      ("plant", po::value<std::string>()->default_value("stamping"), "plant model (stamping, bead_dispenser)")
+      ("plant", po::value<std::string>(), "plant model (stamping, bead_dispenser; default stamping)")
+      ("io", po::value<std::string>(), "run on bench I/O instead (a file with an io: section), paced in real time")
+      ("realtime", "pace the scans in real time (always on with --io)")
       ("plant-config", po::value<std::string>(), "plant parameters (YAML)")
       ("seed", po::value<Count>()->default_value(Count{1}, "1"), "seed of the plant's random variation")
       ("cycle-time", po::value<std::string>()->default_value("10ms"), "cycle time when the program has no CONFIGURATION")
       ("history", po::value<std::string>(), "run history (SQLite; default $PLCFI_HISTORY or ~/.local/state/plcfi/history.sqlite)")
-      ("log", po::value<std::string>(), "folder for each run's log: TEST.log (text) and TEST.csv (snapshots)")
+      ("log", po::value<std::string>(), "folder for each run's log: TEST.log (text), TEST.csv (snapshots), TEST.vcd (every scan)")
       ("junit", po::value<std::string>(), "write JUnit XML (undecidable: skipped, with m_ci)")
-      ("link-fault", po::value<std::string>(), "break the link to the plant in every run: AT:FOR, e.g. 100ms:300ms")
+      ("link-fault", po::value<std::string>(), "break a link in every run: [DEVICE=]AT:FOR, e.g. 100ms:300ms (DEVICE: plant offline, the first of the io file on a bench)")
       ("link-status", po::value<std::string>(), "an %IX bit that reads TRUE while the link to the plant works")
       ("max-wait", po::value<std::string>()->default_value("1s"), "how long ASSERT_COM re-checks through a communication error")
       ("alpha", po::value<double>()->default_value(0.1, "0.1"), "m_ci: least value in the middle band")
@@ -151,13 +158,18 @@ int cmd_script(const std::vector<std::string>& args) {
     return 2;
   }
   int64_t fault_at = -1, fault_for = 0;
+  std::string fault_device;
   if (vm.count("link-fault")) {
-    const std::string v = vm["link-fault"].as<std::string>();
+    std::string v = vm["link-fault"].as<std::string>();
+    if (size_t eq = v.find('='); eq != std::string::npos) {
+      fault_device = v.substr(0, eq);
+      v = v.substr(eq + 1);
+    }
     size_t colon = v.find(':');
     if (colon == std::string::npos || !rt::parse_duration(v.substr(0, colon), &fault_at, &err) ||
         !rt::parse_duration(v.substr(colon + 1), &fault_for, &err) || fault_for <= 0) {
-      std::cerr << "plcfi script: --link-fault: expected AT:FOR with two durations, e.g. 100ms:300ms" << (err.empty() ? "" : " (" + err + ")")
-                << ", got '" << v << "'\n";
+      std::cerr << "plcfi script: --link-fault: expected [DEVICE=]AT:FOR with two durations, e.g. 100ms:300ms"
+                << (err.empty() ? "" : " (" + err + ")") << ", got '" << vm["link-fault"].as<std::string>() << "'\n";
       return 2;
     }
   }
@@ -172,9 +184,8 @@ int cmd_script(const std::vector<std::string>& args) {
   const st::Application& app = *b->app;
   std::vector<script::Script> parsed(scripts.size());
   std::vector<script::BoundScript> bound(scripts.size());
-  const std::vector<std::string> devices = {"plant"};
   for (size_t i = 0; i < scripts.size(); ++i) {
-    if (!script::load_script(scripts[i], &parsed[i], &err) || !script::bind_script(app, parsed[i], devices, &bound[i], &err)) {
+    if (!script::load_script(scripts[i], &parsed[i], &err)) {
       std::cerr << err << "\n";
       return 2;
     }
@@ -189,29 +200,80 @@ int cmd_script(const std::vector<std::string>& args) {
     std::cerr << "plcfi script: " << err << "\n";
     return 2;
   }
-  auto plant = plant::make_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
-  if (!plant) {
-    std::cerr << "plcfi script: " << err << "\n";
+  const bool bench = vm.count("io") > 0;
+  if (bench && (vm.count("plant") || vm.count("plant-config") || vm.count("link-status"))) {
+    std::cerr << "plcfi script: --io runs on the bench's devices; --plant, --plant-config and --link-status are for the plant model\n";
     return 2;
   }
-  const std::string plant_name = plant->name();
-  auto sim = io::SimBackend::create(app, std::move(plant), &err);
-  if (!sim) {
-    std::cerr << "plcfi script: " << err << "\n";
-    return 2;
-  }
-  std::optional<rt::ImageRef> status;
-  if (vm.count("link-status")) {
-    rt::ImageRef ref;
-    if (!rt::parse_image_ref(app, vm["link-status"].as<std::string>(), &ref, &err) || ref.area != 'I' || !ref.is_bit) {
-      std::cerr << "plcfi script: --link-status: " << (err.empty() ? "expected an input bit such as %IX1.0" : err) << "\n";
+  // Offline: the plant model behind a link that can be broken. On a bench: the devices of
+  // the io file, each of which can be.
+  std::unique_ptr<io::SimBackend> sim;
+  std::unique_ptr<io::LinkFaultBackend> link;
+  std::unique_ptr<io::BenchIo> bench_io;
+  io::IoConfig cfg;
+  std::string where;  // the plant, or the io file
+  rt::IoBackend* backend = nullptr;
+  if (bench) {
+    if (!io::load_io_config(vm["io"].as<std::string>(), app, &cfg, &err) || !(bench_io = io::BenchIo::open(cfg, sched.tick_ns(), &err))) {
+      std::cerr << err << "\n";
       return 2;
     }
-    status = ref;
+    backend = bench_io.get();
+    where = "bench I/O " + cfg.path;
+  } else {
+    auto plant = plant::make_plant(vm.count("plant") ? vm["plant"].as<std::string>() : "stamping",
+                                   vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
+    if (!plant) {
+      std::cerr << "plcfi script: " << err << "\n";
+      return 2;
+    }
+    where = "plant " + plant->name();
+    if (!(sim = io::SimBackend::create(app, std::move(plant), &err))) {
+      std::cerr << "plcfi script: " << err << "\n";
+      return 2;
+    }
+    std::optional<rt::ImageRef> status;
+    if (vm.count("link-status")) {
+      rt::ImageRef ref;
+      if (!rt::parse_image_ref(app, vm["link-status"].as<std::string>(), &ref, &err) || ref.area != 'I' || !ref.is_bit) {
+        std::cerr << "plcfi script: --link-status: " << (err.empty() ? "expected an input bit such as %IX1.0" : err) << "\n";
+        return 2;
+      }
+      status = ref;
+    }
+    link = std::make_unique<io::LinkFaultBackend>(sim.get(), "plant", status);
+    backend = link.get();
   }
-  io::LinkFaultBackend link(sim.get(), "plant", status);
-  ro.link = &link;
-  rt::Runtime runtime(app, sched, &link);
+  const std::vector<std::string> devices = backend->link_devices();
+  for (size_t i = 0; i < scripts.size(); ++i) {
+    if (!script::bind_script(app, parsed[i], devices, &bound[i], &err)) {
+      std::cerr << err << "\n";
+      return 2;
+    }
+  }
+  if (fault_at >= 0) {
+    if (fault_device.empty() && !devices.empty()) fault_device = devices.front();
+    bool known = false;
+    for (const auto& d : devices) known = known || d == fault_device;
+    if (!known) {
+      std::string list;
+      for (const auto& d : devices) list += (list.empty() ? "" : ", ") + d;
+      std::cerr << "plcfi script: --link-fault: unknown device '" << fault_device << "' (known: " << (list.empty() ? "none" : list) << ")\n";
+      return 2;
+    }
+  }
+  rt::Runtime runtime(app, sched, backend);
+  if (bench) runtime.set_safe_state(cfg.safe_state);
+  // Every way out once the devices are open: the safe output state reaches them first.
+  struct SafeExit {
+    rt::Runtime& rt;
+    io::BenchIo* io;
+    ~SafeExit() {
+      if (!io) return;
+      rt.write_safe_outputs();
+      io->close();
+    }
+  } safe_exit{runtime, bench_io.get()};
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi script"))) return 2;
   runtime.machine().set_native(native.get());
@@ -237,9 +299,23 @@ int cmd_script(const std::vector<std::string>& args) {
   const uint64_t seed = vm["seed"].as<Count>().value;
   report::JunitSuite suite;
   suite.name = "plcfi script";
-  suite.properties = {{"plant", plant_name}, {"history", history_path}};
+  suite.properties = {{"io", where}, {"history", history_path}};
   int failed = 0, undecidable = 0, passed = 0;
-  std::cout << fmt::format("plcfi script: {} on plant {}, history {}\n", programs.front(), plant_name, history_path);
+  std::cout << fmt::format("plcfi script: {} on {}, history {}\n", programs.front(), where, history_path);
+  // Paced on a bench (or offline with --realtime): the real-time loop watches signals and
+  // lost devices; a way out it takes ends the run undecidable, with its reason.
+  std::unique_ptr<rt::ScanLoop> loop;
+  if (bench || vm.count("realtime")) {
+    loop = std::make_unique<rt::ScanLoop>(runtime, true, &signals, [&bench_io] { return bench_io ? bench_io->lost() : std::string(); });
+    ro.scan = [&loop](rt::Runtime&, std::string* why) {
+      if (loop->check_stop() != rt::LoopEnd::None) {
+        *why = loop->end_reason();
+        return false;
+      }
+      loop->scan();
+      return true;
+    };
+  }
   for (size_t i = 0; i < bound.size(); ++i) {
     const script::Script& s = parsed[i];
     std::vector<std::string> pous;
@@ -249,8 +325,33 @@ int cmd_script(const std::vector<std::string>& args) {
       return 2;
     }
     runtime.cold_restart(seed);
-    if (fault_at >= 0) link.break_link(runtime.now() + fault_at, fault_for);
+    if (fault_at >= 0) backend->break_link(fault_device, runtime.now() + fault_at, fault_for);
+    if (loop) loop->start();
+    // The log's waveform: every scan of the run, the variables a snapshot records that a
+    // VCD can show.
+    std::unique_ptr<report::TraceWriter> vcd;
+    std::unique_ptr<TraceHook> vcd_hook;
+    if (!log_dir.empty()) {
+      std::vector<st::VarHandle> traced;
+      for (const auto& v : script::snapshot_variables(app))
+        if (v.is_bit || v.type->is_elementary()) traced.push_back(v);
+      if (!(vcd = report::open_vcd(log_dir + "/" + s.name + ".vcd", traced, &err))) {
+        std::cerr << "plcfi script: --log: " << err << "\n";
+        return 2;
+      }
+      vcd_hook = std::make_unique<TraceHook>(std::vector<report::TraceWriter*>{vcd.get()});
+      runtime.add_hooks(vcd_hook.get());
+    }
+    const uint64_t failed_before = backend->failed_exchanges();
     script::ScriptResult r = script::run_script(runtime, bound[i], ro);
+    if (vcd) {
+      runtime.remove_hooks(vcd_hook.get());
+      if (!vcd->close(&err)) {
+        std::cerr << "plcfi script: --log: " << err << "\n";
+        return 2;
+      }
+    }
+    const uint64_t failed_now = backend->failed_exchanges() - failed_before;
     std::string pou_list;
     for (const auto& p : pous) pou_list += (pou_list.empty() ? "" : ", ") + p;
     std::cout << fmt::format("\n[{}] {}  ({} s on the scan clock, {} scans; POUs {}; p_lst {} of the latest {})\n", s.path,
@@ -267,7 +368,7 @@ int cmd_script(const std::vector<std::string>& args) {
     if (!r.reason.empty() && !waited) std::cout << "  " << r.reason << "\n";
     if (r.verdict == script::Verdict::Undecidable && !r.asserts.empty() && r.asserts.back().has_mci)
       std::cout << fmt::format("  possible external problem, factor = {:.3g}\n", r.asserts.back().mci);
-    if (link.lost() > 0) std::cout << fmt::format("  link to the plant: {} exchange(s) lost (fault injected)\n", link.lost());
+    if (failed_now > 0) std::cout << fmt::format("  communication: {} exchange(s) failed\n", failed_now);
 
     script::HistoryRow row;
     row.test = s.name;

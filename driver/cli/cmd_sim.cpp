@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "trace_hook.hpp"
 #include "engine.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "monitor/edtl.hpp"
@@ -92,17 +93,6 @@ class MonitorHook final : public rt::ScanHooks {
 
  private:
   monitor::MonitorSet* set_;
-};
-
-class TraceHook final : public rt::ScanHooks {
- public:
-  explicit TraceHook(std::vector<report::TraceWriter*> w) : writers_(std::move(w)) {}
-  void end_of_scan(rt::Runtime& r) override {
-    for (auto* w : writers_) w->sample(r.now(), r.machine());
-  }
-
- private:
-  std::vector<report::TraceWriter*> writers_;
 };
 
 bool is_alarm_name(const std::string& name) {

@@ -20,9 +20,17 @@ uint32_t LinkFaultBackend::input_extent() const {
   return e;
 }
 
-void LinkFaultBackend::break_link(int64_t from_ns, int64_t duration_ns) {
+std::vector<std::string> LinkFaultBackend::link_devices() const {
+  std::vector<std::string> d{device_};
+  for (auto& n : inner_->link_devices()) d.push_back(std::move(n));
+  return d;
+}
+
+bool LinkFaultBackend::break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) {
+  if (device != device_) return inner_->break_link(device, from_ns, duration_ns);
   from_ns_ = from_ns;
   to_ns_ = from_ns + duration_ns;
+  return true;
 }
 
 bool LinkFaultBackend::read(uint8_t* inputs, int64_t now_ns) {

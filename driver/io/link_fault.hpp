@@ -32,9 +32,10 @@ class LinkFaultBackend final : public rt::IoBackend {
   const std::string& last_error() const override { return error_; }
   uint64_t failed_exchanges() const override { return lost_ + inner_->failed_exchanges(); }
 
+  std::vector<std::string> link_devices() const override;
+  // Its own device here, any other one in the wrapped backend.
+  bool break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) override;
   const std::string& device() const { return device_; }
-  // The link is down during [from_ns, from_ns + duration_ns) of the scan clock.
-  void break_link(int64_t from_ns, int64_t duration_ns);
   bool down(int64_t now_ns) const { return now_ns >= from_ns_ && now_ns < to_ns_; }
   uint64_t lost() const { return lost_; }
 

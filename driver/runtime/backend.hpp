@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace plcfi::rt {
 
@@ -28,6 +29,13 @@ class IoBackend {
   // late reply, a broken link): the communication-error indicator of test scripts.
   // Backends that cannot fail (a simulated plant) count none.
   virtual uint64_t failed_exchanges() const { return 0; }
+  // The devices whose link a test script may break (FAULT LINK device), by name.
+  virtual std::vector<std::string> link_devices() const { return {}; }
+  // Breaks the link to `device` during [from_ns, from_ns + duration_ns) of the scan clock:
+  // its requests are lost (counted in failed_exchanges), its inputs keep their last good
+  // values, its outputs are not delivered and its status bit reads FALSE. False when the
+  // backend has no such device.
+  virtual bool break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) { return false; }
 };
 
 }  // namespace plcfi::rt

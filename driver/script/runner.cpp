@@ -126,7 +126,8 @@ class Run {
         return scans((ns + tick - 1) / tick);
       }
       case CmdKind::FaultLink:
-        opt_.link->break_link(rt_.now(), duration_ns(c.amount, c.unit));
+        // The device was checked against the backend's when the script was bound.
+        if (rt_.backend()) rt_.backend()->break_link(c.device, rt_.now(), duration_ns(c.amount, c.unit));
         return true;
       case CmdKind::Assert:
       case CmdKind::AssertCom: return check(bc);

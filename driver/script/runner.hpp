@@ -8,7 +8,6 @@
 #include <string>
 #include <vector>
 
-#include "io/link_fault.hpp"
 #include "runtime/realtime.hpp"
 #include "runtime/runtime.hpp"
 #include "script/bind.hpp"
@@ -22,8 +21,6 @@ struct RunOptions {
   int64_t max_wait_ns = 1'000'000'000;
   // Passes among the latest psi runs of this test since its POUs last changed (history).
   int64_t p_lst = 0;
-  // Offline link faults (FAULT LINK plant ...); null: the script may not use FAULT LINK.
-  io::LinkFaultBackend* link = nullptr;
   // SIGINT/SIGTERM: the run ends at the next scan, undecidable.
   const rt::StopSignals* signals = nullptr;
   // One scan; the default is Runtime::scan() (virtual time). A bench run paces it and

@@ -75,6 +75,19 @@ bool BenchIo::write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) {
   return ok;
 }
 
+std::vector<std::string> BenchIo::link_devices() const {
+  std::vector<std::string> d;
+  for (const auto* p : parts_)
+    for (auto& n : p->link_devices()) d.push_back(std::move(n));
+  return d;
+}
+
+bool BenchIo::break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) {
+  for (auto* p : parts_)
+    if (p->break_link(device, from_ns, duration_ns)) return true;
+  return false;
+}
+
 void BenchIo::reset(uint64_t seed) {
   for (auto* p : parts_) p->reset(seed);
 }

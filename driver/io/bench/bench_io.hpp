@@ -28,6 +28,8 @@ class BenchIo final : public rt::IoBackend {
   bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) override;
   void reset(uint64_t seed) override;
   const std::string& last_error() const override { return error_; }
+  std::vector<std::string> link_devices() const override;
+  bool break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) override;
   uint64_t failed_exchanges() const override {
     uint64_t n = 0;
     for (const auto* p : parts_) n += p->failed_exchanges();

@@ -167,13 +167,38 @@ void ModbusBackend::reset(uint64_t) {
   }
 }
 
-bool ModbusBackend::read(uint8_t* inputs, int64_t) {
+std::vector<std::string> ModbusBackend::link_devices() const {
+  std::vector<std::string> d;
+  for (const auto& c : cfg_.devices) d.push_back(c.name);
+  return d;
+}
+
+bool ModbusBackend::break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) {
+  for (size_t i = 0; i < cfg_.devices.size(); ++i)
+    if (cfg_.devices[i].name == device) {
+      dev_[i].broken_from = from_ns;
+      dev_[i].broken_to = from_ns + duration_ns;
+      return true;
+    }
+  return false;
+}
+
+bool ModbusBackend::read(uint8_t* inputs, int64_t scan_ns) {
   const int64_t now = mono();
   bool ok = true;
+  auto broken = [&](size_t d) { return scan_ns >= dev_[d].broken_from && scan_ns < dev_[d].broken_to; };
   for (size_t i = 0; i < dev_.size(); ++i)
-    if (!ensure(i, now)) ok = false;
+    if (!broken(i) && !ensure(i, now)) ok = false;
   for (const Block& b : blocks_) {
-    if (b.output || !dev_[b.device].connected) continue;
+    if (b.output) continue;
+    if (broken(b.device)) {
+      // The injected fault: the request is lost on the way; the image keeps its values.
+      ++stats_[b.device].requests;
+      ++stats_[b.device].failures;
+      ok = false;
+      continue;
+    }
+    if (!dev_[b.device].connected) continue;
     modbus_t* ctx = dev_[b.device].ctx;
     int n = -1;
     switch (b.table) {
@@ -207,14 +232,20 @@ bool ModbusBackend::read(uint8_t* inputs, int64_t) {
     }
   }
   for (size_t i = 0; i < dev_.size(); ++i)
-    if (cfg_.devices[i].has_status) cfg_.devices[i].status.set(inputs, dev_[i].connected ? 1 : 0);
+    if (cfg_.devices[i].has_status) cfg_.devices[i].status.set(inputs, dev_[i].connected && !broken(i) ? 1 : 0);
   return ok;
 }
 
-bool ModbusBackend::write(const uint8_t* outputs, int64_t, int64_t) {
+bool ModbusBackend::write(const uint8_t* outputs, int64_t scan_ns, int64_t) {
   const int64_t now = mono();
   bool ok = true;
   for (const Block& b : blocks_) {
+    if (b.output && scan_ns >= dev_[b.device].broken_from && scan_ns < dev_[b.device].broken_to) {
+      ++stats_[b.device].requests;
+      ++stats_[b.device].failures;
+      ok = false;
+      continue;
+    }
     if (!b.output || !dev_[b.device].connected) {
       if (b.output) ok = false;
       continue;

@@ -44,6 +44,10 @@ class ModbusBackend final : public rt::IoBackend {
   const std::string& last_error() const override { return error_; }
 
   const std::vector<DeviceStats>& stats() const { return stats_; }
+  // The Modbus devices of the io file; a broken link skips their requests (each counted
+  // as failed) as a pulled cable would, without touching the connection.
+  std::vector<std::string> link_devices() const override;
+  bool break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) override;
   // Failed requests of every device (a timeout, a refused or broken connection, a short
   // or wrong answer).
   uint64_t failed_exchanges() const override {
@@ -70,6 +74,7 @@ class ModbusBackend final : public rt::IoBackend {
     modbus_t* ctx = nullptr;
     bool connected = false;
     int64_t next_attempt = 0, backoff = 0, down_since = -1;
+    int64_t broken_from = 0, broken_to = 0;  // an injected link fault, on the scan clock
   };
   ModbusBackend() = default;
   bool ensure(size_t d, int64_t now);

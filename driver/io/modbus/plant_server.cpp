@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <thread>
 #include <vector>
 
 #include <sys/select.h>
@@ -111,6 +112,7 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
 
   std::vector<int> clients;
   std::vector<uint8_t> query(MODBUS_TCP_MAX_ADU_LENGTH);
+  uint64_t rng = opt.seed * 0x9e3779b97f4a7c15ull + 1;  // the link's losses (drop_rate)
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   auto next = start + std::chrono::nanoseconds(opt.tick_ns);
@@ -191,8 +193,20 @@ bool serve_plant(plant::Plant& plant, const PlantServerOptions& opt, const std::
       modbus_set_socket(c.ctx, fd);
       int n = modbus_receive(c.ctx, query.data());
       if (n > 0) {
-        modbus_reply(c.ctx, query.data(), n, c.map);
         ++stats->requests;
+        // A lost request: answered never. The draw comes first so that the sequence of
+        // losses depends on the seed and the request count only.
+        rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+        const double u = static_cast<double>(rng >> 11) * 0x1.0p-53;
+        if (u < opt.drop_rate) {
+          ++stats->dropped;
+        } else {
+          if (opt.stall_ns > 0) {
+            std::this_thread::sleep_for(std::chrono::nanoseconds(opt.stall_ns));
+            ++stats->stalled;
+          }
+          modbus_reply(c.ctx, query.data(), n, c.map);
+        }
         ++k;
       } else if (n == 0) {
         ++k;  // a request for another unit on RTU; not on TCP

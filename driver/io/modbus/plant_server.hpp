@@ -24,10 +24,15 @@ struct PlantServerOptions {
   int64_t tick_ns = 1'000'000;      // plant step
   int64_t duration_ns = 0;          // 0: until stopped
   uint64_t seed = 1;
+  // A bad link, to rehearse communication faults: each request is left unanswered with
+  // this probability (0..1), and every answer waits stall_ns before it goes out (beyond the
+  // master's response timeout it arrives too late). Deterministic for a seed.
+  double drop_rate = 0.0;
+  int64_t stall_ns = 0;
 };
 
 struct PlantServerStats {
-  uint64_t steps = 0, requests = 0, connections = 0, resets = 0;
+  uint64_t steps = 0, requests = 0, connections = 0, resets = 0, dropped = 0, stalled = 0;
   int64_t late_steps = 0;  // ticks that started after their deadline (overloaded machine)
 };
 

@@ -40,7 +40,6 @@ class BeadStand {
     std::string err;
     EXPECT_TRUE(parse_script("t.cpt", text, &script, &err)) << err;
     EXPECT_TRUE(bind_script(*b->app, script, {"plant"}, &bound, &err)) << err;
-    ro.link = link.get();
     rt->cold_restart(1);
     return run_script(*rt, bound, ro);
   }
