@@ -84,5 +84,21 @@ grep -q "interrupted (SIGINT)\|SIGINT" "$work/int.txt"
 coils=$(mbpoll -m tcp -a 1 -t 0 -r 1 -c 2 -1 -p "$port" 127.0.0.1 | sed -n 's/^\[\([0-9]*\)\]:[[:space:]]*\([01]\)$/\2/p' | tr -d '\n')
 echo "coils after SIGINT: $coils"
 [[ "$coils" == "00" ]]
+
+echo "== 5. FAULT LINK on a device of the io file: its requests are lost, the assertion waits"
+printf 'FAULT LINK dispenser FOR 2 S\nSET PASS_ONE_BALL\nWAIT 500 MS\nASSERT_COM ISTRUE IS_BEAD_SEEN\n' > "$work/fault.cpt"
+set +e
+"$plcfi" script "$dir/bead_dispenser.st" "$work/fault.cpt" --io "$work/io.yaml" --history "$hist" --max-wait 200ms > "$work/fault.txt" 2>&1
+s=$?
+set -e
+cat "$work/fault.txt"
+grep -q "waited 20 cycle(s) through a communication error, it never held" "$work/fault.txt"
+grep -q "communication: [1-9][0-9]* exchange(s) failed" "$work/fault.txt"
 stop_server
+
+echo "== 6. the device gone: the run ends undecidable (communication lost), without a hang"
+"$plcfi" script "$dir/bead_dispenser.st" "$work/long.cpt" --io "$work/io.yaml" --history "$hist" > "$work/gone.txt" 2>&1
+cat "$work/gone.txt"
+grep -q "\] Undecidable" "$work/gone.txt"
+grep -q "communication lost: dispenser" "$work/gone.txt"
 echo "script over Modbus: published result reproduced"

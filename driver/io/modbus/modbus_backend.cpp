@@ -188,7 +188,10 @@ bool ModbusBackend::read(uint8_t* inputs, int64_t scan_ns) {
   bool ok = true;
   auto broken = [&](size_t d) { return scan_ns >= dev_[d].broken_from && scan_ns < dev_[d].broken_to; };
   for (size_t i = 0; i < dev_.size(); ++i)
-    if (!broken(i) && !ensure(i, now)) ok = false;
+    if (!broken(i) && !ensure(i, now)) {
+      ok = false;
+      ++stats_[i].missed;
+    }
   for (const Block& b : blocks_) {
     if (b.output) continue;
     if (broken(b.device)) {

@@ -20,6 +20,7 @@ namespace plcfi::io {
 
 struct DeviceStats {
   uint64_t requests = 0, failures = 0, connects = 0, disconnects = 0;
+  uint64_t missed = 0;  // scans in which the device was down (not connected): no exchange at all
   bool up = false;
   std::string last_error;  // "plant (127.0.0.1:1502) unit 1: read discrete_inputs 0..15: Connection refused"
 };
@@ -49,10 +50,10 @@ class ModbusBackend final : public rt::IoBackend {
   std::vector<std::string> link_devices() const override;
   bool break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) override;
   // Failed requests of every device (a timeout, a refused or broken connection, a short
-  // or wrong answer).
+  // or wrong answer), and the scans in which a device was down and not asked at all.
   uint64_t failed_exchanges() const override {
     uint64_t n = 0;
-    for (const auto& s : stats_) n += s.failures;
+    for (const auto& s : stats_) n += s.failures + s.missed;
     return n;
   }
   // The device that has been down longer than its lost_after, on the monotonic clock
