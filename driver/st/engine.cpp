@@ -91,6 +91,8 @@ bool split_path(std::string_view path, std::vector<PathPart>* out, std::string* 
       size_t j = i;
       while (j < path.size() && std::isdigit(static_cast<unsigned char>(path[j]))) ++j;
       part.is_bit = true;
+      // A bit of at most a LWORD: two digits; longer is out of range, not a number to read.
+      if (j - i > 2) return fail("bit number at column " + std::to_string(i + 1) + " is out of range (0..63)");
       part.bit = static_cast<uint32_t>(std::stoul(std::string(path.substr(i, j - i))));
       i = j;
     } else {
@@ -107,6 +109,7 @@ bool split_path(std::string_view path, std::vector<PathPart>* out, std::string* 
           size_t d = k;
           while (k < path.size() && std::isdigit(static_cast<unsigned char>(path[k]))) ++k;
           if (k == d) return fail("expected a constant index at column " + std::to_string(i + 1));
+          if (k - d > 18) return fail("index at column " + std::to_string(i + 1) + " is out of range");
           part.indices.push_back(std::stoll(std::string(path.substr(i, k - i))));
           i = k;
           while (i < path.size() && path[i] == ' ') ++i;

@@ -39,9 +39,11 @@ for cmd in "${commands[@]}"; do
   # A command shown failing on purpose says so: `$ plcfi ... # exits 2`.
   expected="0 1"
   [[ "$cmd" =~ \#\ *exits\ ([0-9]+) ]] && expected=${BASH_REMATCH[1]}
+  started=$SECONDS
   out=$(eval "$cmd" 2>&1)
   status=$?
   printf '%s\n' "$out" | tail -n 4
+  echo "  ($((SECONDS - started)) s)"   # the real-time examples dominate; on a loaded machine too
   if [[ " $expected " != *" $status "* ]] || grep -qE "terminate called|Sanitizer|runtime error:" <<<"$out"; then
     echo "  -> FAILED: exit status $status (expected ${expected// / or })"
     failures=$((failures + 1))
