@@ -28,12 +28,21 @@ for cmd in "${commands[@]}"; do
   echo "\$ $cmd"
   if [[ "$cmd" == *"&" ]]; then            # a server for the next commands
     eval "${cmd% &*} > .bg.log 2>&1 &"
+    server=$!
     for _ in $(seq 1 100); do grep -q listening .bg.log 2>/dev/null && break; sleep 0.05; done
     continue
   fi
-  if [[ "$cmd" == kill* ]]; then           # ends that server: the job lives in this shell
-    eval "$cmd" || { echo "  -> FAILED"; failures=$((failures + 1)); }
-    wait
+  if [[ "$cmd" == kill* ]]; then           # ends that server
+    # By its pid, not the job spec README shows: a job table without job control has
+    # been seen to leave `wait` waiting for ever (twice, beside another build).
+    eval "${cmd//%1/$server}" || { echo "  -> FAILED"; failures=$((failures + 1)); }
+    for _ in $(seq 1 400); do kill -0 "$server" 2>/dev/null || break; sleep 0.05; done
+    if kill -0 "$server" 2>/dev/null; then
+      echo "  -> FAILED: the server did not end within 20 s of the signal ($(grep -E 'SigPnd|SigCgt' /proc/$server/status | tr '\n' ' '))"
+      kill -9 "$server"
+      failures=$((failures + 1))
+    fi
+    wait "$server" 2>/dev/null
     continue
   fi
   # A command shown failing on purpose says so: `$ plcfi ... # exits 2`.
