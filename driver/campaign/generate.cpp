@@ -127,6 +127,7 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   const Campaign& c = out->spec;
   st::CompileOptions opt;
   opt.warnings = false;
+  st::parse_dialect(c.dialect, &opt.dialect);  // checked when the file was read
 
   // 1. The program alone: bindings, alarms and fault targets are checked against it.
   auto prog = st::build_files(c.programs, opt);

@@ -119,6 +119,7 @@ enum class RestartKind { Cold, Warm };
 struct Campaign {
   std::string path, name, text;
   std::vector<std::string> programs;  // resolved against the campaign file's folder
+  std::string dialect = "iec";        // the programs' ST dialect (iec, codesys)
   std::string plant, plant_config;
   int64_t cycle_ns = 0;  // 0: from the program's CONFIGURATION (else 10 ms)
   uint64_t seed = 1;

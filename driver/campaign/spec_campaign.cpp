@@ -16,7 +16,7 @@ std::string relative_to(const std::string& base_file, const std::string& p) {
 
 void parse_campaign(const common::YamlDoc& f, Campaign* c) {
   f.check_keys(f.root(),
-         {"campaign", "text", "program", "plant", "plant_config", "cycle", "tsd", "fmea", "fault_classes", "seed", "budget",
+         {"campaign", "text", "program", "dialect", "plant", "plant_config", "cycle", "tsd", "fmea", "fault_classes", "seed", "budget",
           "max_paths", "search_window", "restart", "io"},
          "a campaign file");
   c->path = f.path();
@@ -30,6 +30,7 @@ void parse_campaign(const common::YamlDoc& f, Campaign* c) {
   } else {
     f.fail(prog, "program: expected a file or a list of files, got " + common::YamlDoc::describe(prog));
   }
+  if (f.root()["dialect"]) c->dialect = f.word(f.root()["dialect"], "dialect", {"iec", "codesys"});
   c->plant = f.scalar(f.required(f.root(), "plant", "a campaign file"), "plant");
   if (f.root()["plant_config"]) c->plant_config = relative_to(f.path(), f.scalar(f.root()["plant_config"], "plant_config"));
   if (f.root()["cycle"]) c->cycle_ns = f.duration(f.root()["cycle"], "cycle", 1);

@@ -135,6 +135,7 @@ int cmd_script(const std::vector<std::string>& args) {
       ("n", po::value<double>()->default_value(1.0, "1"), "m_ci: shape of the fall from beta to alpha (1: linear)")
       ("native", "run the program through the native tier");
   po::variables_map vm;
+  add_dialect_options(desc);
   if (!parse_args(args, desc, vm, usage)) return 0;
   std::vector<std::string> programs, scripts;
   for (const auto& f : strings_of(vm, "files")) (ends_with(f, ".cpt") ? scripts : programs).push_back(f);
@@ -176,6 +177,7 @@ int cmd_script(const std::vector<std::string>& args) {
 
   // Everything is read and checked before anything runs.
   st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
   opt.warnings = false;
   auto b = st::build_files(programs, opt);
   for (const auto& e : b->io_errors) std::cerr << e << "\n";

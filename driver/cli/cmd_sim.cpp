@@ -120,6 +120,7 @@ int cmd_sim(const std::vector<std::string>& args) {
       ("requirements", po::value<std::string>(), "EDTL requirements (YAML) checked every scan")
       ("native", "run the program (and the monitors) through the native tier");
   po::variables_map vm;
+  add_dialect_options(desc);
   if (!parse_args(args, desc, vm,
                   "plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
                   "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml]"))
@@ -145,6 +146,7 @@ int cmd_sim(const std::vector<std::string>& args) {
     late.push_back(mon.source(reqs.path));
   }
   st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
   opt.warnings = false;
   auto b = st::build_files(files, opt, late);
   for (const auto& e : b->io_errors) std::cerr << e << "\n";

@@ -63,8 +63,10 @@ int cmd_check(const std::vector<std::string>& args) {
   po::options_description desc("plcfi check: compile ST files and report every error and warning");
   desc.add_options()("no-warnings", "report errors only");
   po::variables_map vm;
+  add_dialect_options(desc);
   if (!parse_args(args, desc, vm, "plcfi check FILES... [--no-warnings]")) return 0;
   st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
   opt.warnings = !vm.count("no-warnings");
   opt.test_mode = true;  // test files may be checked too; their built-ins are then known
   auto b = load(strings_of(vm, "files"), opt, "check");
@@ -79,8 +81,10 @@ int cmd_disasm(const std::vector<std::string>& args) {
   po::options_description desc("plcfi disasm: print the bytecode of ST files with their source lines");
   desc.add_options()("native", "print the C++ the native tier generates instead");
   po::variables_map vm;
+  add_dialect_options(desc);
   if (!parse_args(args, desc, vm, "plcfi disasm FILES... [--native]")) return 0;
   st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
   opt.warnings = false;
   auto b = load(strings_of(vm, "files"), opt, "disasm");
   if (!b || !b->ok()) return 2;
@@ -113,8 +117,10 @@ int cmd_run(const std::vector<std::string>& args) {
       ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with --realtime: pin the scan thread to this CPU")
       ("junit", po::value<std::string>(), "with --io or --realtime: JUnit XML with the wake latency, execution time and overruns as properties");
   po::variables_map vm;
+  add_dialect_options(desc);
   if (!parse_args(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE] [--realtime [--rt-priority N] [--cpu N]] [--duration T] [--junit F]")) return 0;
   st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
   opt.warnings = false;
   auto b = load(strings_of(vm, "files"), opt, "run");
   if (!b || !b->ok()) return 2;
@@ -253,8 +259,10 @@ int cmd_test(const std::vector<std::string>& args) {
       ("budget", po::value<Count>()->default_value(Count{100'000'000}, "100000000"), "loop iterations allowed per test phase (watchdog)")
       ("native", "run the tests through the native tier (generated C++, compiled by the system's compiler)");
   po::variables_map vm;
+  add_dialect_options(desc);
   if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage]")) return 0;
   st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
   opt.test_mode = true;
   opt.warnings = false;
   auto b = load(strings_of(vm, "files"), opt, "test");

@@ -13,6 +13,8 @@
 #include <boost/program_options.hpp>
 #include <fmt/format.h>
 
+#include "codegen/compiler.hpp"
+
 namespace plcfi::cli {
 
 // Decimal digits with an optional sign, no spaces: the sign and the magnitude. False when
@@ -103,6 +105,21 @@ inline bool parse_args(const std::vector<std::string>& args, boost::program_opti
     return false;
   }
   return true;
+}
+
+// --dialect and --strict, on every command that reads ST.
+inline void add_dialect_options(boost::program_options::options_description& desc) {
+  desc.add_options()
+      ("dialect", boost::program_options::value<std::string>()->default_value("iec"),
+       "ST dialect: iec (IEC 61131-3) or codesys (CODESYS and TwinCAT 3: implicit conversions as warnings, ...)")
+      ("strict", "with --dialect codesys: the dialect's implicit conversions are errors");
+}
+// The dialect options into `opt`; a dialect that does not exist is a usage error.
+inline void apply_dialect_options(const boost::program_options::variables_map& vm, st::CompileOptions* opt) {
+  const std::string& d = vm["dialect"].as<std::string>();
+  if (!st::parse_dialect(d, &opt->dialect))
+    throw boost::program_options::error("--dialect must be iec or codesys, not '" + d + "'");
+  opt->strict = vm.count("strict") != 0;
 }
 
 // The values of a repeatable string option or of the plain arguments; empty when absent.

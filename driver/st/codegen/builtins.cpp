@@ -2,6 +2,7 @@
 // requirement monitors and the test-file built-ins. Their signatures and type rules are
 // in sema/stdfuncs; here each family of functions has one emitter, picked from a table.
 #include <algorithm>
+#include <cmath>
 
 #include "compiler_impl.hpp"
 #include "sema/stdfuncs.hpp"
@@ -86,6 +87,35 @@ std::optional<std::vector<const Expr*>> test_args(Compiler& cc, const StdFunc& f
     args.push_back(a.value.get());
   }
   return args;
+}
+
+bool untyped_number(const Val& v) {
+  return v.is_const && !v.type && (v.c.k == ConstV::K::Int || v.c.k == ConstV::K::Real);
+}
+
+double as_double(const ConstV& c) { return c.k == ConstV::K::Real ? c.r : static_cast<double>(c.i); }
+
+// MIN, MAX and LIMIT of untyped literals only: an untyped literal again (an integer when
+// all are integers), so that the context types it as it would the literal itself.
+std::optional<Val> fold_untyped_pick(Pick pick, const std::vector<Val>& vals) {
+  if (!std::all_of(vals.begin(), vals.end(), untyped_number)) return std::nullopt;
+  bool real = std::any_of(vals.begin(), vals.end(), [](const Val& v) { return v.c.k == ConstV::K::Real; });
+  auto less = [&](const Val& a, const Val& b) { return real ? as_double(a.c) < as_double(b.c) : a.c.i < b.c.i; };
+  Val r;
+  if (pick == Pick::Limit) {
+    // LIMIT(MN, IN, MX) = MIN(MAX(IN, MN), MX)
+    r = less(vals[1], vals[0]) ? vals[0] : vals[1];
+    if (less(vals[2], r)) r = vals[2];
+  } else {
+    r = vals[0];
+    for (size_t i = 1; i < vals.size(); ++i)
+      if (pick == Pick::Min ? less(vals[i], r) : less(r, vals[i])) r = vals[i];
+  }
+  if (real && r.c.k == ConstV::K::Int) {
+    r.c.k = ConstV::K::Real;
+    r.c.r = static_cast<double>(r.c.i);
+  }
+  return r;
 }
 
 Val void_val(Compiler& cc) {
@@ -240,10 +270,23 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
   if (from) {
     v = coerce(v, from, args[0]->loc, name.c_str());
     if (!v.ok) return bad();
+  } else if (!v.type && conv.bcd == ConversionName::Bcd::Decode && v.c.k == ConstV::K::Int) {
+    from = elem(TypeKind::LWord);  // BCD_TO_INT(16#0399): the literal's digits as a bit string
   } else {
     from = v.type ? v.type : default_type(v.c);
   }
   Slot s = to_slot(v, from, args[0]->loc);
+  if (conv.bcd != ConversionName::Bcd::None) {
+    bool decode = conv.bcd == ConversionName::Bcd::Decode;
+    if (decode ? !from->is_bitstring() : !from->is_integer()) {
+      diags_.error("ST203", args[0]->loc, name + (decode ? " needs a bit string (BYTE, WORD, ...) holding BCD digits, not "
+                                                         : " needs an integer, not ") + from->name);
+      return bad();
+    }
+    const Type* U64 = elem(TypeKind::ULInt);
+    Val r = native(decode ? Native::BCD_DECODE : Native::BCD_ENCODE, U64, {convert(s, from, U64)});
+    return slot_val(to, convert(r.slot, U64, to));
+  }
   // Not an error: an impossible conversion is an unknown function (reported by the caller).
   ConversionKind kind = conversion_kind(from, to, conv.trunc);
   if (from->kind == TypeKind::Enum) from = from->base;  // TO_INT(enum value)
@@ -366,6 +409,14 @@ std::optional<Val> Compiler::emit_expt(const StdFunc& f, const CallExpr& c) {
   if (args.empty()) return bad();
   auto vals = eval_all(*this, args);
   if (!ok_all(vals)) return bad();
+  if (untyped_number(vals[0]) && untyped_number(vals[1])) {
+    // EXPT(2.0, 3.0): an untyped REAL literal, typed where it is used (r := ... with r a REAL).
+    Val out;
+    out.is_const = true;
+    out.c.k = ConstV::K::Real;
+    out.c.r = std::pow(as_double(vals[0].c), as_double(vals[1].c));
+    return out;
+  }
   const Type* t = real_of(*this, vals[0].type);
   // An integer base is taken as it is and widened; an untyped or REAL one as t.
   const Type* at = vals[0].type && !vals[0].type->is_real() ? vals[0].type : t;
@@ -381,6 +432,12 @@ std::optional<Val> Compiler::emit_abs(const StdFunc& f, const CallExpr& c) {
   if (args.empty()) return bad();
   Val v = expr(*args[0]);
   if (!v.ok) return bad();
+  if (v.is_const && !v.type && (v.c.k == ConstV::K::Int || v.c.k == ConstV::K::Real)) {
+    // ABS(-11): still an untyped literal, typed where it is used (i := ABS(-11) + i).
+    if (v.c.k == ConstV::K::Int && v.c.i < 0) v.c.i = static_cast<int64_t>(0ULL - static_cast<uint64_t>(v.c.i));
+    if (v.c.k == ConstV::K::Real) v.c.r = std::fabs(v.c.r);
+    return v;
+  }
   const Type* t = v.type ? v.type : default_type(v.c);
   if (!t->is_numeric()) {
     diags_.error("ST203", args[0]->loc, "ABS needs a number, not " + t->name);
@@ -399,6 +456,7 @@ std::optional<Val> Compiler::emit_extremum(const StdFunc& f, const CallExpr& c) 
   if (args.empty()) return bad();
   auto vals = eval_all(*this, args);
   if (!ok_all(vals)) return bad();
+  if (auto folded = fold_untyped_pick(f.pick, vals)) return *folded;
   const Type* t = first_type(*this, vals);
   if (!t || !is_min_max_operand(t)) {
     diags_.error("ST203", c.loc, name + " needs numbers of compatible types");
@@ -540,7 +598,11 @@ std::optional<Val> Compiler::emit_shift(const StdFunc& f, const CallExpr& c) {
   Val v = expr(*args[0]);
   Val n = expr(*args[1]);
   if (!v.ok || !n.ok) return bad();
-  const Type* t = v.type ? v.type : elem(TypeKind::DWord);
+  // An untyped literal is shifted in the context's width (b := ROR(16#45, 7) rotates a
+  // BYTE), else as a DWORD.
+  const Type* want = call_expected_;
+  const Type* t = v.type ? v.type : want && (want->is_bitstring() || want->is_integer()) ? want : elem(TypeKind::DWord);
+  if (t->ranged) t = elem(t->kind);
   if (!is_shift_operand(t)) {
     diags_.error("ST203", args[0]->loc, name + " needs a bit string or integer, not " + t->name);
     return bad();

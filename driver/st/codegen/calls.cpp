@@ -141,9 +141,11 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
         diags_.error("ST211", m.member.loc, "method " + base.type->name + "." + meth->name + " is PRIVATE");
         return bad();
       }
-      // Calls through THIS dispatch on the instance's run-time type; SUPER and plain
-      // instances (whose type is exactly their declaration) bind statically.
-      return call_method(c, meth, &base, addr_of(base, c.loc), via_this && !via_super);
+      // Calls through THIS, a reference or a VAR_IN_OUT (which may hold a derived
+      // instance) dispatch on the instance's run-time type; SUPER and plain instances
+      // (whose type is exactly their declaration) bind statically.
+      bool indirect = base.k == Place::K::Ind && has_derived(base.type->pou);
+      return call_method(c, meth, &base, addr_of(base, c.loc), (via_this || indirect) && !via_super);
     }
     if (base.type->kind == TypeKind::Struct) {
       Place inner = member_place(base, m.member, callee.loc);
@@ -215,7 +217,7 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
     if (p->where == Where::InOut) {
       Place src = place(*a.value, true);
       if (!src.ok) continue;
-      if (!same_type(src.type, p->type) && src.type != p->type) {
+      if (!same_type(src.type, p->type) && src.type != p->type && !derives(src.type, p->type)) {
         diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a variable of type " + p->type->name + ", not " + src.type->name);
         continue;
       }
@@ -310,7 +312,7 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     if (p->where == Where::InOut) {
       Place src = place(*a.value, true);
       if (!src.ok) continue;
-      if (!same_type(src.type, p->type) && src.type != p->type) {
+      if (!same_type(src.type, p->type) && src.type != p->type && !derives(src.type, p->type)) {
         diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a variable of type " + p->type->name + ", not " + src.type->name);
         continue;
       }
@@ -541,7 +543,7 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
 Val Compiler::property_get(const Place& inst, PouInfo* getter, Slot this_ptr, SourceLoc loc) {
   CallExpr c(loc);
   bool virt = !inst.ok || inst.type == nullptr || inst.type->kind != TypeKind::Pou ||
-              (b_->this_type && inst.type == b_->this_type);
+              (b_->this_type && inst.type == b_->this_type) || (inst.k == Place::K::Ind && has_derived(inst.type->pou));
   return call_method(c, getter, &inst, this_ptr, virt);
 }
 

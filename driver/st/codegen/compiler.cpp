@@ -842,6 +842,15 @@ bool Compiler::link(Application& app, const std::vector<const CompilationUnit*>&
 
 }  // namespace detail
 
+const char* dialect_name(Dialect d) { return d == Dialect::Codesys ? "codesys" : "iec"; }
+
+bool parse_dialect(std::string_view text, Dialect* out) {
+  if (iequals(text, "iec")) *out = Dialect::Iec;
+  else if (iequals(text, "codesys")) *out = Dialect::Codesys;
+  else return false;
+  return true;
+}
+
 std::unique_ptr<Application> compile(const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
                                      const std::vector<const TestFile*>& tests, DiagEngine& diags,
                                      const CompileOptions& options) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "syntax/ast.hpp"
@@ -10,7 +11,17 @@
 
 namespace plcfi::st {
 
+// Which tools' ST the front end accepts. Iec: IEC 61131-3 (3rd edition) as written.
+// Codesys: what CODESYS and TwinCAT 3 accept besides, chiefly implicit conversions between
+// elementary types (each one a warning naming the conversion; `strict` makes them errors).
+enum class Dialect : uint8_t { Iec, Codesys };
+const char* dialect_name(Dialect d);
+// "iec" or "codesys" (any case); false for anything else.
+bool parse_dialect(std::string_view text, Dialect* out);
+
 struct CompileOptions {
+  Dialect dialect = Dialect::Iec;
+  bool strict = false;  // the dialect's implicit conversions are errors, not warnings
   // Test builds: FBs count their calls and can be mocked, functions can be mocked,
   // the ASSERT_*/ADVANCE_TIME/MOCK_* built-ins are available.
   bool test_mode = false;

@@ -187,6 +187,14 @@ class Compiler {
   void declare_vars(PouInfo* p);
   void declare_globals(const std::vector<VarBlock>& blocks, const std::string& scope, uint32_t file);
   std::optional<ConstV> const_eval(const Expr& e, uint32_t file, bool report = true);
+  // `Colour.Red`: an enumeration value qualified by its type's name (CODESYS, TwinCAT),
+  // when the base names no variable or instance. Null when m is no such thing; a type
+  // without that value is reported (once) and gives null too, with *reported set.
+  struct EnumValueRef {
+    const Type* type;
+    int64_t value;
+  };
+  std::optional<EnumValueRef> qualified_enum(const MemberExpr& m, uint32_t file, bool report, bool* reported = nullptr);
   std::optional<int64_t> const_int(const Expr& e, uint32_t file);
   void write_init(std::vector<uint8_t>& image, uint32_t offset, const Type* t, const Expr* init, uint32_t file);
   bool write_const(uint8_t* dst, const Type* t, const ConstV& c, SourceLoc loc);
@@ -196,6 +204,17 @@ class Compiler {
   void declare_pou(PouInfo* p);
   void ensure_layout(PouInfo* p, SourceLoc use);
   bool implements(const PouInfo* fb, const PouInfo* itf) const;
+  // An instance of `from` may stand where `to` is expected: the same FB type or one
+  // derived from it (EXTENDS, any depth), as the 3rd edition allows for VAR_IN_OUT and
+  // references.
+  bool derives(const Type* from, const Type* to) const;
+  // The dialect's implicit conversions (see CompileOptions::dialect).
+  bool dialect_converts(const Type* from, const Type* to) const;
+  Val implicit_conversion(const Val& v, const Type* to, SourceLoc loc, const char* what);
+  const Type* dialect_common_type(const Type* a, const Type* b) const;
+  // Whether some FB extends `fb`: then an instance reached through a reference or a
+  // VAR_IN_OUT may be of a derived type, and its methods dispatch at run time.
+  bool has_derived(const PouInfo* fb) const;
   uint32_t selector(const std::string& method_canon);
 
   // ---- bodies (compiler.cpp)

@@ -380,6 +380,21 @@ std::optional<int64_t> Compiler::const_int(const Expr& e, uint32_t file) {
   return c->i;
 }
 
+std::optional<Compiler::EnumValueRef> Compiler::qualified_enum(const MemberExpr& m, uint32_t file, bool report, bool* reported) {
+  if (reported) *reported = false;
+  if (m.base->kind != ExprKind::Name) return std::nullopt;
+  const Ident& tn = static_cast<const NameExpr&>(*m.base).name;
+  std::string key = canon(tn.text);
+  if (lookup(key) || !types_.count(key)) return std::nullopt;
+  const Type* t = named_type(tn, file, report);
+  if (!t || t->kind != TypeKind::Enum) return std::nullopt;
+  for (const auto& [n, v] : t->enum_values)
+    if (iequals(n, m.member.text)) return EnumValueRef{t, v};
+  if (report) diags_.error("ST230", m.member.loc, "'" + m.member.text + "' is not a value of " + t->name);
+  if (reported) *reported = true;
+  return std::nullopt;
+}
+
 std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool report) {
   auto fail = [&](const std::string& msg) -> std::optional<ConstV> {
     if (report) diags_.error("ST215", e.loc, msg);
@@ -437,6 +452,13 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
         return fail("'" + el.value.text + "' is not a value of " + t->name);
       }
       return fail("'" + el.type_name.text + "' is not an enumeration");
+    }
+    case ExprKind::Member: {
+      bool reported = false;
+      if (auto ev = qualified_enum(static_cast<const MemberExpr&>(e), file, report, &reported))
+        return ConstV{ConstV::K::Int, ev->value, 0, {}};
+      if (reported) return std::nullopt;
+      return fail("a constant expression is required here");
     }
     case ExprKind::Name: {
       const auto& n = static_cast<const NameExpr&>(e);
@@ -982,6 +1004,20 @@ void Compiler::ensure_compiled(PouInfo* p, SourceLoc use) {
     return;
   }
   compile_pou(p);
+}
+
+bool Compiler::derives(const Type* from, const Type* to) const {
+  if (!from || !to || from->kind != TypeKind::Pou || to->kind != TypeKind::Pou || !to->pou) return false;
+  for (const PouInfo* f = from->pou; f; f = f->base)
+    if (f == to->pou) return true;
+  return false;
+}
+
+bool Compiler::has_derived(const PouInfo* fb) const {
+  if (!fb) return false;
+  for (const auto& [name, p] : pous_)
+    if (p->base == fb) return true;
+  return false;
 }
 
 bool Compiler::implements(const PouInfo* fb, const PouInfo* itf) const {

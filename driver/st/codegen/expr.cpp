@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 
+#include <fmt/format.h>
+
 #include "compiler_impl.hpp"
 
 namespace plcfi::st::detail {
@@ -124,7 +126,7 @@ Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* wh
     return out;
   }
   if (v.type == to || implicitly_converts(v.type, to) || (v.type->is_string() && to->is_string()) ||
-      (v.type->kind == TypeKind::Ref && to->kind == TypeKind::Ref && same_type(v.type, to))) {
+      (v.type->kind == TypeKind::Ref && to->kind == TypeKind::Ref && (same_type(v.type, to) || derives(v.type->target, to->target)))) {
     // A constant takes the target type; a computed value keeps its own type so that
     // to_slot() knows what to convert from.
     if (v.is_const && to->is_elementary()) {
@@ -143,12 +145,77 @@ Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* wh
     out.type = to;
     return out;
   }
+  if (opt_.dialect == Dialect::Codesys && dialect_converts(v.type, to)) return implicit_conversion(v, to, loc, what);
   std::string hint;
-  if (v.type->is_elementary() && to->is_elementary() && v.type->kind != TypeKind::Enum && to->kind != TypeKind::Enum)
+  if (v.type->is_elementary() && to->is_elementary() && v.type->kind != TypeKind::Enum && to->kind != TypeKind::Enum &&
+      v.type->kind != TypeKind::Ref && to->kind != TypeKind::Ref)
     hint = "; use " + canon(v.type->name) + "_TO_" + canon(to->name) + "()";
   diags_.error("ST203", loc, "cannot convert " + v.type->name + " to " + to->name + " implicitly" +
                                  (what ? std::string(" in ") + what : "") + hint);
   return bad();
+}
+
+// CODESYS and TwinCAT convert between any two numbers, bit strings and BOOL implicitly.
+bool Compiler::dialect_converts(const Type* from, const Type* to) const {
+  auto number = [](const Type* t) {
+    return t->is_numeric() || t->is_bitstring() || (t->kind == TypeKind::Bool);
+  };
+  return from->is_elementary() && to->is_elementary() && number(from) && number(to);
+}
+
+// A conversion IEC 61131-3 wants written out, done implicitly as the dialect does: a
+// warning naming the conversion (an error with --strict), and the conversion the function
+// of that name would do (a REAL to an integer rounds).
+Val Compiler::implicit_conversion(const Val& v, const Type* to, SourceLoc loc, const char* what) {
+  const Type* from = v.type;
+  bool narrowing = !implicitly_converts(to, from) || (from->is_real() && !to->is_real());
+  std::string fn = canon(from->name) + "_TO_" + canon(to->name);
+  std::string msg = fmt::format("implicit conversion from {} to {}{} ({}){}", from->name, to->name,
+                                what ? std::string(" in ") + what : std::string(), fn,
+                                narrowing ? ": values outside the target's range or precision change" : "");
+  if (opt_.strict) {
+    diags_.error("ST203", loc, msg + "; write " + fn + "() (--strict)");
+    return bad();
+  }
+  if (opt_.warnings) diags_.warning("ST405", loc, msg);
+  Val out = v;
+  out.type = to;
+  if (v.is_const) {
+    if (from->is_real() && !to->is_real()) {
+      out.c.k = ConstV::K::Int;
+      out.c.i = static_cast<int64_t>(std::nearbyint(v.c.r));
+    } else if (!from->is_real() && to->is_real() && v.c.k == ConstV::K::Int) {
+      out.c.k = ConstV::K::Real;
+      out.c.r = static_cast<double>(v.c.i);
+    }
+    // Wrap to the target's width, as a run-time conversion would.
+    if (out.c.k == ConstV::K::Int && to->size < 8) {
+      uint64_t mask = (uint64_t(1) << (to->size * 8)) - 1;
+      uint64_t bits = static_cast<uint64_t>(out.c.i) & mask;
+      if (to->kind == TypeKind::Bool) bits = out.c.i != 0;
+      else if (to->is_integer() && !to->is_unsigned_int() && (bits >> (to->size * 8 - 1)))
+        bits |= ~mask;
+      out.c.i = static_cast<int64_t>(bits);
+    }
+    return out;
+  }
+  Slot s = v.slot;
+  if (to->kind == TypeKind::Bool) {
+    Slot t = temp(1, 1);
+    if (from->is_real()) emit(num_op(Op::NE_I8, from->storage()), {t, s, konst(from, ConstV{ConstV::K::Real, 0, 0.0, {}}, loc)});
+    else emit(from->size == 1 ? Op::TOBOOL8 : from->size == 2 ? Op::TOBOOL16 : from->size == 4 ? Op::TOBOOL32 : Op::TOBOOL64, {t, s});
+    def(t);
+    out.slot = t;
+    return out;
+  }
+  if (from->is_real() && !to->is_real()) {
+    Slot r = temp_for(from);
+    emit(from->kind == TypeKind::Real ? Op::ROUND_F32 : Op::ROUND_F64, {r, s});
+    def(r);
+    s = r;
+  }
+  out.slot = convert(s, from, to);
+  return out;
 }
 
 Slot Compiler::to_slot(const Val& v, const Type* t, SourceLoc loc) {
@@ -332,6 +399,15 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
       }
       case ExprKind::Member: {
         const auto& m = static_cast<const MemberExpr&>(e);
+        bool reported = false;
+        if (auto ev = qualified_enum(m, file_, true, &reported)) {
+          Val out;
+          out.is_const = true;
+          out.type = ev->type;
+          out.c = ConstV{ConstV::K::Int, ev->value, 0, {}};
+          return out;
+        }
+        if (reported) return bad();
         // Properties: obj.Prop reads call the getter.
         auto try_property = [&]() -> std::optional<Val> {
           if (m.base->kind == ExprKind::Name) {
@@ -419,11 +495,18 @@ Val Compiler::unary(const UnaryExpr& u, const Type* expected) {
       }
       return out;
     }
+    // NOT of an untyped literal takes its width from the context (b := NOT 16#99 with b
+    // a BYTE), as the standard types a literal where it is used.
+    const Type* width = v.type;
+    if (!width && v.c.k == ConstV::K::Int && expected && (expected->is_bitstring() || expected->is_integer()))
+      width = expected;
     if (v.c.k == ConstV::K::Bool) out.c.i = !v.c.i;
-    else if (v.c.k == ConstV::K::Int && v.type) {
-      // NOT on a typed bit string: complement within its width.
-      uint64_t mask = v.type->size >= 8 ? ~0ULL : ((1ULL << (v.type->size * 8)) - 1);
+    else if (v.c.k == ConstV::K::Int && width) {
+      // NOT on a bit string: complement within its width.
+      uint64_t mask = width->size >= 8 ? ~0ULL : ((1ULL << (width->size * 8)) - 1);
       out.c.i = static_cast<int64_t>(~static_cast<uint64_t>(v.c.i) & mask);
+      if (width->is_integer() && !width->is_unsigned_int()) out.c.i = ~v.c.i;
+      out.type = v.type ? v.type : (width->ranged ? elem(width->kind) : width);
     } else {
       diags_.error("ST204", u.loc, "NOT needs a BOOL or bit-string value");
       return bad();
@@ -647,6 +730,7 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   }
 
   const Type* t = common_type(*tt_, lt, rt);
+  if (!t && opt_.dialect == Dialect::Codesys) t = dialect_common_type(lt, rt);
   if (!t) {
     // IEC forbids mixing, say, DINT and REAL implicitly; say what to write instead.
     diags_.error("ST204", e.loc, std::string("operator ") + op_text(e.op) + " mixes " + lt->name + " and " + rt->name +
@@ -710,6 +794,28 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     }
     default: return op_error();
   }
+}
+
+// The type CODESYS computes a mixed operation in (REAL * BYTE, INT + UDINT, WORD AND
+// INT): the real type when one side is real (LREAL when either is), else an integer wide
+// enough for both (signed when either is signed, one size up when the unsigned side is
+// as wide). Null when a side is no number or bit string.
+const Type* Compiler::dialect_common_type(const Type* a, const Type* b) const {
+  auto number = [](const Type* t) { return t->is_numeric() || t->is_bitstring(); };
+  if (!number(a) || !number(b)) return nullptr;
+  if (a->is_real() || b->is_real())
+    return elem(a->kind == TypeKind::LReal || b->kind == TypeKind::LReal ? TypeKind::LReal : TypeKind::Real);
+  bool sa = a->is_integer() && !a->is_unsigned_int(), sb = b->is_integer() && !b->is_unsigned_int();
+  uint32_t w = std::max(a->size, b->size);
+  if (sa == sb) {
+    static constexpr TypeKind kS[] = {TypeKind::SInt, TypeKind::Int, TypeKind::DInt, TypeKind::LInt};
+    static constexpr TypeKind kU[] = {TypeKind::USInt, TypeKind::UInt, TypeKind::UDInt, TypeKind::ULInt};
+    uint32_t i = w == 1 ? 0 : w == 2 ? 1 : w == 4 ? 2 : 3;
+    return elem(sa ? kS[i] : kU[i]);
+  }
+  uint32_t unsigned_w = sa ? b->size : a->size;
+  if (unsigned_w >= w && w < 8) w *= 2;
+  return elem(w == 1 ? TypeKind::SInt : w == 2 ? TypeKind::Int : w == 4 ? TypeKind::DInt : TypeKind::LInt);
 }
 
 Val Compiler::cond(const Expr& e) {

@@ -180,8 +180,44 @@ const StdFunc* find_std_function(std::string_view upper_name) {
 std::optional<ConversionName> parse_conversion(const TypeTable& tt, std::string_view upper_name) {
   std::string_view from_name, to_name;
   ConversionName out;
+  using Bcd = ConversionName::Bcd;
+  auto ends_with = [](std::string_view s, std::string_view tail) {
+    return s.size() >= tail.size() && s.substr(s.size() - tail.size()) == tail;
+  };
   size_t at = upper_name.find("_TO_");
-  if (at != std::string_view::npos) {
+  size_t trunc_at = upper_name.find("_TRUNC_");
+  if (upper_name.rfind("TRUNC_", 0) == 0) {
+    to_name = upper_name.substr(6);
+    out.trunc = true;
+  } else if (trunc_at != std::string_view::npos) {
+    from_name = upper_name.substr(0, trunc_at);
+    to_name = upper_name.substr(trunc_at + 7);
+    out.trunc = true;
+  } else if (upper_name.rfind("BCD_TO_", 0) == 0) {
+    to_name = upper_name.substr(7);
+    out.bcd = Bcd::Decode;
+  } else if (upper_name.rfind("TO_BCD_", 0) == 0) {
+    to_name = upper_name.substr(7);
+    out.bcd = Bcd::Encode;
+  } else if (at != std::string_view::npos && at >= 4 && upper_name.substr(at - 4, 4) == "_BCD") {
+    from_name = upper_name.substr(0, at - 4);  // WORD_BCD_TO_UINT
+    to_name = upper_name.substr(at + 4);
+    out.bcd = Bcd::Decode;
+  } else if (at != std::string_view::npos && upper_name.substr(at + 4).rfind("BCD_", 0) == 0) {
+    from_name = upper_name.substr(0, at);  // UINT_TO_BCD_WORD
+    to_name = upper_name.substr(at + 8);
+    out.bcd = Bcd::Encode;
+  } else if (at != std::string_view::npos && ends_with(upper_name, "_TO_BCD")) {
+    // INT_TO_BCD: into the bit string of the integer's width.
+    from_name = upper_name.substr(0, at);
+    out.from = tt.by_name(from_name);
+    if (!out.from || !out.from->is_integer()) return std::nullopt;
+    static constexpr TypeKind kBits[] = {TypeKind::Byte, TypeKind::Word, TypeKind::DWord, TypeKind::LWord};
+    uint32_t w = out.from->size == 1 ? 0 : out.from->size == 2 ? 1 : out.from->size == 4 ? 2 : 3;
+    out.to = tt.elementary(kBits[w]);
+    out.bcd = Bcd::Encode;
+    return out;
+  } else if (at != std::string_view::npos) {
     from_name = upper_name.substr(0, at);
     to_name = upper_name.substr(at + 4);
   } else if (upper_name.rfind("TO_", 0) == 0) {
@@ -195,6 +231,10 @@ std::optional<ConversionName> parse_conversion(const TypeTable& tt, std::string_
   out.to = tt.by_name(to_name);
   out.from = from_name.empty() ? nullptr : tt.by_name(from_name);
   if (!out.to || (!from_name.empty() && !out.from)) return std::nullopt;
+  if (out.trunc && !(out.to->is_integer() || out.to->is_bitstring())) return std::nullopt;
+  if (out.trunc && out.from && !out.from->is_real()) return std::nullopt;
+  if (out.bcd == Bcd::Decode && !(out.to->is_integer() && (!out.from || out.from->is_bitstring()))) return std::nullopt;
+  if (out.bcd == Bcd::Encode && !(out.to->is_bitstring() && (!out.from || out.from->is_integer()))) return std::nullopt;
   return out;
 }
 

@@ -84,11 +84,15 @@ const StdFunc* find_std_function(std::string_view upper_name);
 // ---- conversions
 
 // A conversion function's name taken apart: X_TO_Y, TO_Y (from = null: the argument's
-// own type) or TRUNC (to DINT, from the argument's type).
+// own type), TRUNC (to DINT, from the argument's type), TRUNC_Y and X_TRUNC_Y, and the
+// BCD forms.
 struct ConversionName {
   const Type* from = nullptr;
   const Type* to = nullptr;
   bool trunc = false;
+  // BCD: WORD_BCD_TO_UINT, BCD_TO_INT (decode the bit string's nibbles as decimal digits),
+  // UINT_TO_BCD_WORD, INT_TO_BCD, TO_BCD_WORD (encode).
+  enum class Bcd : uint8_t { None, Decode, Encode } bcd = Bcd::None;
 };
 // Null when the name is no conversion (or names a type that does not exist).
 std::optional<ConversionName> parse_conversion(const TypeTable& tt, std::string_view upper_name);

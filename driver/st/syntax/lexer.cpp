@@ -370,6 +370,13 @@ Token Lexer::lex_string(char quote) {
   while (pos_ < text_.size()) {
     const char c = text_[pos_];
     if (c == quote) {
+      // A doubled quote stands for one ('it''s'), as CODESYS and TwinCAT write it. Two
+      // string literals side by side are never valid ST, so no program changes meaning.
+      if (peek(1) == quote) {
+        value += c;
+        pos_ += 2;
+        continue;
+      }
       ++pos_;
       terminated = true;
       break;

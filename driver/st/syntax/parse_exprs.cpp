@@ -109,6 +109,13 @@ ExprPtr Parser::parse_postfix() {
                                   k != Tok::To && k != Tok::By;
       if (at(Tok::Ident) || keyword_member) {
         const Token& t = advance();
+        if (e->kind == ExprKind::This || e->kind == ExprKind::Super) {
+          // THIS.x and SUPER.M(): the reference dereferenced, as if written THIS^.x
+          // (several tools accept the member access without the '^').
+          auto d = std::make_unique<DerefExpr>(e->loc);
+          d->base = std::move(e);
+          e = std::move(d);
+        }
         auto m = std::make_unique<MemberExpr>(e->loc);
         m->base = std::move(e);
         m->member = Ident{std::string(t.text), t.loc};
@@ -283,6 +290,17 @@ ExprPtr Parser::parse_primary() {
       d->parts = t.parts;
       return d;
     }
+    case Tok::And: case Tok::Or: case Tok::Xor: case Tok::Mod:
+      if (la(1).kind == Tok::LParen) {
+        // The functional form of an operator, AND(a, b, c): a call of the standard
+        // function of that name (where an operand starts, the word cannot be the operator).
+        advance();
+        auto n = std::make_unique<NameExpr>(t.loc);
+        n->name = Ident{canon(t.text), t.loc};
+        return n;
+      }
+      error("ST115", missing_loc(), "expected an expression, found " + describe(t));
+      return error_expr(t.loc);
     case Tok::This: advance(); return std::make_unique<ThisExpr>(t.loc);
     case Tok::Super: advance(); return std::make_unique<SuperExpr>(t.loc);
     case Tok::LParen: {

@@ -203,6 +203,19 @@ void dt_to_tod(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
   store_as<int64_t>(a, v - floor_div(v, kDayNs) * kDayNs);
 }
 
+// BCD: each nibble a decimal digit, the lowest nibble the units. A nibble above 9 counts
+// as its value, as the usual library code (digit * 10 + next) computes it.
+void bcd_decode(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  uint64_t v = load_as<uint64_t>(b), out = 0, scale = 1;
+  for (int i = 0; i < 16 && v; ++i, v >>= 4, scale *= 10) out += (v & 0xF) * scale;
+  store_as<uint64_t>(a, out);
+}
+void bcd_encode(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  uint64_t v = load_as<uint64_t>(b), out = 0;
+  for (int shift = 0; shift < 64 && v; shift += 4, v /= 10) out |= (v % 10) << shift;
+  store_as<uint64_t>(a, out);
+}
+
 struct Entry {
   NativeFn fn;
   const char* name;
@@ -219,6 +232,7 @@ constexpr Entry kNatives[] = {
     {s_to_i64, "STRING_TO_I64"}, {s_to_u64, "STRING_TO_U64"}, {s_to_f64, "STRING_TO_LREAL"},
     {s_to_bool, "STRING_TO_BOOL"}, {s_to_time, "STRING_TO_TIME"},
     {dt_to_date, "DT_TO_DATE"}, {dt_to_tod, "DT_TO_TOD"},
+    {bcd_decode, "BCD_DECODE"}, {bcd_encode, "BCD_ENCODE"},
 };
 static_assert(sizeof(kNatives) / sizeof(kNatives[0]) == static_cast<size_t>(Native::Count_));
 

@@ -17,6 +17,7 @@ enum class Native : uint32_t {
   I64_TO_S, U64_TO_S, F32_TO_S, F64_TO_S, BOOL_TO_S, TIME_TO_S, DATE_TO_S, TOD_TO_S, DT_TO_S,
   S_TO_I64, S_TO_U64, S_TO_F64, S_TO_BOOL, S_TO_TIME,
   DT_TO_DATE, DT_TO_TOD,
+  BCD_DECODE, BCD_ENCODE,  // a := f(b), both ULINT
   Count_
 };
 
