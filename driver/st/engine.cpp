@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "import/import.hpp"
 #include "syntax/parser.hpp"
 #include "vm/natives.hpp"
 
@@ -45,6 +46,12 @@ std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const 
     std::string err;
     if (!b->sm.load(p, &idx, &err)) {
       b->io_errors.push_back(err);
+      continue;
+    }
+    // A project file is not ST: its importer adds the units it holds (the file itself
+    // stays loaded, for the messages that point into it).
+    if (input_kind(p) == InputKind::PlcopenXml) {
+      import_plcopen(p, b->sm, b->diags, &files);
       continue;
     }
     files.push_back(idx);
