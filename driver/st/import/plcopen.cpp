@@ -711,6 +711,11 @@ class Importer {
     std::string name;
     if (!name_of(d, "<dataType>", &name)) return;
     std::string what = "data type '" + name + "'";
+    // CODESYS writes the declaration as the user typed it too (TYPE ... END_TYPE): preferred.
+    if (pugi::xml_node text = plain_text(d)) {
+      begin_unit(name);
+      if (copy_plain_text(text)) return end_unit();
+    }
     pugi::xml_node base = child(d, "baseType");
     if (!base) return error("ST603", d, what + " has no <baseType>");
     begin_unit(name);

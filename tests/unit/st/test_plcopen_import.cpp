@@ -251,6 +251,52 @@ END_FUNCTION_BLOCK
   EXPECT_TRUE(ok);
 }
 
+TEST(PlcopenImport, CodesysGlobalVariableListAndPlainTextDataType) {
+  XmlFile f(kHead + R"(<types><dataTypes>
+<dataType name="S"><baseType><struct/></baseType>
+  <addData><data name="http://www.3s-software.com/plcopenxml/interfaceasplaintext" handleUnknown="implementation">
+    <InterfaceAsPlainText><xhtml xmlns="http://www.w3.org/1999/xhtml">TYPE S :
+STRUCT
+  a : INT := 1;
+END_STRUCT
+END_TYPE
+</xhtml></InterfaceAsPlainText></data></addData></dataType>
+</dataTypes><pous/></types>
+<instances><configurations/></instances>
+<addData><data name="http://www.3s-software.com/plcopenxml/globalvars" handleUnknown="implementation">
+  <globalVars name="GVL"><variable name="s"><type><derived name="S"/></type></variable></globalVars>
+  <globalVars name="GVL2"><addData><data name="http://www.3s-software.com/plcopenxml/interfaceasplaintext" handleUnknown="implementation">
+    <InterfaceAsPlainText><xhtml xmlns="http://www.w3.org/1999/xhtml">VAR_GLOBAL
+  n : INT := 3;
+END_VAR</xhtml></InterfaceAsPlainText></data></addData></globalVars>
+</data></addData>
+</project>
+)");
+  Imported r = import(f);
+  EXPECT_TRUE(r.ok) << r.diags;
+  EXPECT_EQ(r.text, R"(---- X.xml(S)
+TYPE S :
+STRUCT
+  a : INT := 1;
+END_STRUCT
+END_TYPE
+---- X.xml(GVL)
+VAR_GLOBAL
+s
+:
+S
+;
+END_VAR
+---- X.xml(GVL2)
+VAR_GLOBAL
+  n : INT := 3;
+END_VAR
+)");
+  bool ok = false;
+  EXPECT_EQ(build_diags(f, &ok), "");
+  EXPECT_TRUE(ok);
+}
+
 // A type error in an ST body with entities before it on the line: reported at the XML
 // line and column of the offending name, with the XML line shown.
 TEST(PlcopenImport, ErrorInABodyPointsIntoTheXml) {
