@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -454,7 +455,13 @@ class Importer {
     std::string s;
     if (k == "simpleValue") {
       if (!required(v, "value", what + ": <simpleValue>", &s)) return;
-      copy("", attr_copy(v, "value"), suffix);
+      Copy c = attr_copy(v, "value");
+      // CODESYS writes an enumeration value E.V; plcfi reads E#V (same columns).
+      size_t dot = c.text.find('.');
+      if (dot != std::string::npos && is_identifier(c.text, true) && c.text.find('.', dot + 1) == std::string::npos &&
+          enums_.count(canon(std::string_view(c.text).substr(0, dot))))
+        c.text[dot] = '#';
+      copy("", c, suffix);
     } else if (k == "arrayValue") {
       auto items = children(v, "value");
       line("[", v);
@@ -808,6 +815,7 @@ class Importer {
   uint32_t file_ = 0;
   std::string_view raw_;
   Unit unit_;
+  std::set<std::string> enums_;  // canonical names of the enumeration data types
   bool unit_broken_ = false;
   bool ok_ = true;
 };
@@ -850,6 +858,8 @@ bool Importer::run() {
     return false;
   }
   pugi::xml_node types = child(project, "types");
+  for (auto d : children(child(types, "dataTypes"), "dataType"))
+    if (child(child(d, "baseType"), "enum")) enums_.insert(canon(d.attribute("name").value()));
   for (auto d : children(child(types, "dataTypes"), "dataType")) data_type(d);
   for (auto p : children(child(types, "pous"), "pou")) pou(p);
   // CODESYS global variable lists: <addData><data name=".../globalvars"><globalVars name=..>.
