@@ -68,10 +68,8 @@ std::vector<std::string> distinguishing_branches(const CampaignBuild& cb, const 
   for (uint32_t b : e.branches) {
     if (common.count(b) || b >= app.branches.size()) continue;
     const auto& bp = app.branches[b];
-    // Where the branch is in the user's file (an imported POU: the line of the .xml).
-    st::SourceLoc at = bp.loc.file < cb.build->sm.size() ? cb.build->sm.origin(bp.loc) : bp.loc;
-    std::string file = at.file < app.file_paths.size() ? app.file_paths[at.file] : "?";
-    out.push_back(fmt::format("{}:{} {} ({})", std::filesystem::path(file).filename().string(), at.line, bp.kind, bp.pou));
+    std::string file = bp.loc.file < app.file_paths.size() ? app.file_paths[bp.loc.file] : "?";
+    out.push_back(fmt::format("{}:{} {} ({})", std::filesystem::path(file).filename().string(), bp.loc.line, bp.kind, bp.pou));
   }
   return out;
 }

@@ -328,20 +328,11 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   }
 
   // The program's own files (branch points elsewhere, e.g. in the standard library, do
-  // not define a control-flow path of the program). The units imported from a project
-  // file (a POU of a .xml) are the program's too: their lines come from that file.
-  const st::SourceManager& sm = out->build->sm;
-  auto is_program = [&](const std::string& path) {
+  // not define a control-flow path of the program).
+  for (uint32_t f = 0; f < app.file_paths.size(); ++f)
     for (const auto& p : c.programs)
-      if (std::filesystem::path(path).lexically_normal() == std::filesystem::path(p).lexically_normal()) return true;
-    return false;
-  };
-  for (uint32_t f = 0; f < app.file_paths.size() && f < sm.size(); ++f) {
-    bool own = is_program(sm.file(f).path);
-    for (const auto& o : sm.file(f).origins)
-      if (!own && o.where.line != 0 && o.file < sm.size()) own = is_program(sm.file(o.file).path);
-    if (own) out->program_files.push_back(f);
-  }
+      if (std::filesystem::path(app.file_paths[f]).lexically_normal() == std::filesystem::path(p).lexically_normal())
+        out->program_files.push_back(f);
 
   for (const auto& l : c.tsd.lifelines) {
     auto h = st::resolve(app, l.bind, &e);
