@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# One CLI case of the PLCopen XML importer: `plcfi ARGS...` run in this folder (so the
+# paths in messages are stable), its complete output and exit status must equal
+# expected/NAME.txt line for line.
+#   usage: cli_snapshot.sh PLCFI NAME ARGS...
+#   PLCFI_UPDATE_SNAPSHOTS=1 rewrites expected/NAME.txt (review the diff before committing).
+set -u
+plcfi=$1
+name=$2
+shift 2
+dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+expected=$dir/expected/$name.txt
+# Wall-clock figures are the only thing that changes from run to run.
+actual=$(cd "$dir" && "$plcfi" "$@" 2>&1 | sed -E 's/[0-9]+(\.[0-9]+)? ?(ms|s) wall/<time> wall/g'; echo "exit=${PIPESTATUS[0]}")
+if [[ "${PLCFI_UPDATE_SNAPSHOTS:-}" == 1 ]]; then
+  mkdir -p "$dir/expected"
+  printf '%s\n' "$actual" > "$expected"
+  echo "wrote $expected"
+  exit 0
+fi
+if [[ ! -f "$expected" ]]; then
+  echo "no snapshot expected/$name.txt; run with PLCFI_UPDATE_SNAPSHOTS=1 and review it. Output:"
+  printf '%s\n' "$actual"
+  exit 1
+fi
+if ! diff -u "$expected" <(printf '%s\n' "$actual"); then
+  echo "$name: output differs from expected/$name.txt (- expected, + actual)"
+  exit 1
+fi
+echo "$name: as expected"
