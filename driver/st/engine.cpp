@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "import/import.hpp"
 #include "syntax/parser.hpp"
 #include "vm/natives.hpp"
 
@@ -45,6 +46,12 @@ std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const 
     std::string err;
     if (!b->sm.load(p, &idx, &err)) {
       b->io_errors.push_back(err);
+      continue;
+    }
+    // A TwinCAT file (read above, so an unreadable one is an I/O error like any other)
+    // gives the ST units it holds; the file itself is not ST.
+    if (input_kind(p) == InputKind::TwinCat) {
+      import_twincat(p, b->sm, b->diags, &files);
       continue;
     }
     files.push_back(idx);
