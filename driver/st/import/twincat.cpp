@@ -134,9 +134,8 @@ std::string ext_of(std::string_view path) {
 // A name usable as an ST identifier and a file stem (the GVL's scope is its unit's stem).
 std::string identifier(std::string_view name, std::string_view fallback) {
   std::string out;
-  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_';
-  if (out.empty()) out = fallback;
-  if (std::isdigit(static_cast<unsigned char>(out[0]))) out.insert(out.begin(), '_');
+  for (char c : name.empty() ? fallback : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' ? c : '_';
+  if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out.insert(out.begin(), '_');
   return out;
 }
 
