@@ -63,10 +63,12 @@ std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const 
       continue;
     }
     // A project file is not ST: its importer adds the units it holds (the file itself
-    // stays loaded, for the messages that point into it).
-    if (input_kind(p) == InputKind::PlcopenXml) {
+    // stays loaded, for the messages that point into it; an unreadable one was an I/O
+    // error above, like any other).
+    if (InputKind kind = input_kind(p); kind != InputKind::St) {
       const size_t first = files.size();
-      import_plcopen(p, b->sm, b->diags, &files);
+      if (kind == InputKind::PlcopenXml) import_plcopen(p, b->sm, b->diags, &files);
+      else import_twincat(p, b->sm, b->diags, &files);
       imported.insert(files.begin() + static_cast<ptrdiff_t>(first), files.end());
       continue;
     }
