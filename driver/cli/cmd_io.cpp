@@ -61,11 +61,18 @@ int run_with_io(const st::Application& app, const rt::Schedule& sched, const std
   const std::string& why = loop.end_reason();
   const uint64_t scans = loop.scans();
   // Every way out: the safe output state reaches the devices before they are closed.
-  runtime.write_safe_outputs();
+  const bool safe = runtime.write_safe_outputs();
+  const std::string safe_error = safe || !backend ? std::string() : backend->last_error();
   if (backend) backend->close();
-  std::cout << fmt::format("plcfi run: {} scans of {} ms over {}, ended: {}; outputs written to the safe state{}\n", scans,
+  std::cout << fmt::format("plcfi run: {} scans of {} ms over {}, ended: {}; {}{}\n", scans,
                            static_cast<double>(sched.tick_ns()) / 1e6, backend ? cfg.path : "no I/O", why,
+                           safe ? "outputs written to the safe state" : "THE SAFE STATE COULD NOT BE WRITTEN",
                            cfg.safe_state.empty() ? " (all off)" : fmt::format(" (all off but {})", cfg.safe_state.size()));
+  if (!safe) {
+    std::cerr << fmt::format("plcfi run: the safe state could not be written: {}; check the outputs at the devices\n",
+                             safe_error);
+    status = 1;
+  }
   for (const auto& line : loop.figures()) std::cout << "  " << line << "\n";
   if (backend)
     for (const auto& line : backend->report()) std::cout << "  " << line << "\n";

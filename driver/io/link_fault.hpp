@@ -27,6 +27,8 @@ class LinkFaultBackend final : public rt::IoBackend {
   uint32_t output_extent() const override { return inner_->output_extent(); }
   bool read(uint8_t* inputs, int64_t now_ns) override;
   bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) override;
+  // The fault is withdrawn for the safe state: it reaches the device.
+  bool write_final(const uint8_t* outputs, int64_t now_ns) override { return inner_->write_final(outputs, now_ns); }
   // A restart ends any fault in progress (a new test run starts with a working link).
   void reset(uint64_t seed) override;
   const std::string& last_error() const override { return error_; }

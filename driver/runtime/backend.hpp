@@ -22,6 +22,11 @@ class IoBackend {
   virtual uint32_t output_extent() const = 0;
   virtual bool read(uint8_t* inputs, int64_t now_ns) = 0;
   virtual bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) = 0;
+  // The safe state, written on the way out (or before a restart): no link fault holds it
+  // back, and a backend whose write can be lost (a reply late on a loaded bench, a
+  // dropped connection) reconnects at once and repeats it. False when it could not be
+  // delivered (last_error() says why).
+  virtual bool write_final(const uint8_t* outputs, int64_t now_ns) { return write(outputs, now_ns, 0); }
   // Back to the initial state (a simulated plant resets its physics; real I/O: nothing).
   virtual void reset(uint64_t seed) = 0;
   virtual const std::string& last_error() const = 0;

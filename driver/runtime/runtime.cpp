@@ -53,10 +53,10 @@ void Runtime::fill_safe(uint8_t* q) {
   for (const auto& [ref, v] : safe_values_) ref.set(q, v);
 }
 
-void Runtime::write_safe_outputs() {
+bool Runtime::write_safe_outputs() {
   fill_safe(machine_.mem() + app_->image_q.addr);
   std::memcpy(out_.data(), machine_.mem() + app_->image_q.addr, out_.size());
-  if (backend_) backend_->write(out_.data(), now_ns_, 0);
+  return !backend_ || backend_->write_final(out_.data(), now_ns_);
 }
 
 void Runtime::stop(const std::string& reason) {

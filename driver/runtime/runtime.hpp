@@ -81,8 +81,9 @@ class Runtime {
   const std::vector<uint64_t>& probe_branches();
 
   // All outputs to the safe state (zero: valves off, setpoints 0, except the configured
-  // exceptions) and sent to the backend.
-  void write_safe_outputs();
+  // exceptions) and sent to the backend (IoBackend::write_final). False when it could not
+  // be delivered (the backend's last_error() says why).
+  bool write_safe_outputs();
   // Outputs whose safe value is not 0 (a brake released by TRUE, a slider kept out
   // under a lowered stamp). Applied after zeroing, in order.
   void set_safe_state(std::vector<std::pair<ImageRef, int64_t>> values) { safe_values_ = std::move(values); }

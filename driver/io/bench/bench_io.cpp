@@ -75,6 +75,16 @@ bool BenchIo::write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) {
   return ok;
 }
 
+bool BenchIo::write_final(const uint8_t* outputs, int64_t now_ns) {
+  bool ok = true;
+  for (auto* p : parts_)
+    if (!p->write_final(outputs, now_ns)) {
+      ok = false;
+      error_ = p->last_error();
+    }
+  return ok;
+}
+
 std::vector<std::string> BenchIo::link_devices() const {
   std::vector<std::string> d;
   for (const auto* p : parts_)

@@ -26,6 +26,7 @@ class BenchIo final : public rt::IoBackend {
   uint32_t output_extent() const override;
   bool read(uint8_t* inputs, int64_t now_ns) override;
   bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) override;
+  bool write_final(const uint8_t* outputs, int64_t now_ns) override;
   void reset(uint64_t seed) override;
   const std::string& last_error() const override { return error_; }
   std::vector<std::string> link_devices() const override;

@@ -39,6 +39,10 @@ class ModbusBackend final : public rt::IoBackend {
   // (one per block) plus one connect attempt per device that is due for it.
   bool read(uint8_t* inputs, int64_t now_ns) override;
   bool write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) override;
+  // Up to kFinalAttempts writes, each after reconnecting at once (no backoff) to a device
+  // dropped by the one before; broken links (test scripts) are ignored.
+  bool write_final(const uint8_t* outputs, int64_t now_ns) override;
+  static constexpr int kFinalAttempts = 5;
   // A restart: devices with a reset_register get 1 written there (a plant that can be
   // re-initialized remotely, as plcfi plant-server); others are left as they are.
   void reset(uint64_t seed) override;

@@ -33,6 +33,7 @@ Diagnostic& DiagEngine::error(std::string code, SourceLoc loc, std::string messa
 }
 
 Diagnostic& DiagEngine::warning(std::string code, SourceLoc loc, std::string message) {
+  if (!warnings_on_) return overflow_ = Diagnostic{};
   return report(Severity::Warning, std::move(code), loc, std::move(message));
 }
 

@@ -31,6 +31,8 @@ class DiagEngine {
   // several times) is not reported again: the earlier one is returned.
   Diagnostic& error(std::string code, SourceLoc loc, std::string message);
   Diagnostic& warning(std::string code, SourceLoc loc, std::string message);
+  // Off: warnings are neither stored nor counted (commands that show errors only).
+  void set_warnings(bool on) { warnings_on_ = on; }
 
   const std::vector<Diagnostic>& all() const { return diags_; }
   size_t error_count() const { return errors_; }
@@ -52,6 +54,7 @@ class DiagEngine {
   Diagnostic overflow_;
   size_t errors_ = 0;
   size_t warnings_ = 0;
+  bool warnings_on_ = true;
 };
 
 }  // namespace plcfi::st

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "common/duration.hpp"
@@ -167,9 +168,216 @@ void Lexer::skip_trivia() {
         pos_ = text_.size();
       } else {
         pos_ = close + 1;
+        pragma(begin, close);
+        if (!active()) skip_inactive();
       }
     } else {
       break;
+    }
+  }
+  if (pos_ >= text_.size() && !conds_.empty()) {
+    error("ST011", conds_.back().at, "{IF} without {END_IF} before the end of the file");
+    conds_.clear();
+  }
+}
+
+bool Lexer::active() const { return conds_.empty() || conds_.back().active; }
+
+namespace {
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
+}
+std::string upper_word(std::string_view s) {
+  std::string w;
+  for (char ch : s) {
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '_') break;
+    w += static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  }
+  return w;
+}
+// The text between the first pair of single quotes, or all of s.
+std::string_view quoted(std::string_view s) {
+  size_t a = s.find('\'');
+  size_t b = a == std::string_view::npos ? a : s.find('\'', a + 1);
+  return b == std::string_view::npos ? trim(s) : s.substr(a + 1, b - a - 1);
+}
+}  // namespace
+
+void Lexer::pragma(size_t begin, size_t end) {
+  std::string_view body = trim(text_.substr(begin + 1, end - begin - 1));
+  std::string word = upper_word(body);
+  std::string_view rest = trim(body.substr(word.size()));
+  bool outer = active();
+  if (word == "IF") {
+    bool on = outer && eval_condition(rest, begin);
+    conds_.push_back({on, on, outer, begin});
+    return;
+  }
+  if (word == "ELSIF" || word == "ELSE" || word == "END_IF") {
+    if (conds_.empty()) {
+      error("ST011", begin, "{" + word + "} without {IF}");
+      return;
+    }
+    Cond& c = conds_.back();
+    if (word == "END_IF") {
+      conds_.pop_back();
+    } else if (word == "ELSE") {
+      c.active = c.outer && !c.taken;
+      c.taken = true;
+    } else {
+      bool on = c.outer && !c.taken && eval_condition(rest, begin);
+      c.active = on;
+      c.taken = c.taken || on;
+    }
+    return;
+  }
+  if (!outer) return;
+  if (word == "DEFINE" || word == "UNDEFINE") {
+    std::string name = upper_word(rest);
+    if (name.empty()) {
+      error("ST011", begin, "{" + std::string(body.substr(0, word.size())) + "} needs a name");
+      return;
+    }
+    defines_.erase(std::remove(defines_.begin(), defines_.end(), name), defines_.end());
+    if (word == "DEFINE") defines_.push_back(name);
+    return;
+  }
+  if (word == "WARNING" || word == "INFO" || word == "TEXT") {
+    if (word == "WARNING") diags_.warning("ST406", loc_at(begin), std::string(quoted(rest)));
+    return;
+  }
+  if (word == "ERROR") {
+    error("ST013", begin, std::string(quoted(rest)));
+    return;
+  }
+  // Pragmas that change nothing a run depends on: declarations' attributes (qualified_only,
+  // hide, call_after_init, ...), regions, library and flag pragmas, CODESYS's messageguid.
+  static const char* const kQuiet[] = {"ATTRIBUTE", "REGION", "ENDREGION", "LIBRARY", "FLAG", "MESSAGEGUID", "BITACCESS",
+                                       "LINKALWAYS", "PRAGMA"};
+  for (const char* q : kQuiet)
+    if (word == q) return;
+  std::string shown(body.substr(0, std::min<size_t>(body.size(), 40)));
+  diags_.warning("ST406", loc_at(begin), "unknown pragma {" + shown + (body.size() > 40 ? "..." : "") + "} ignored");
+}
+
+// defined(NAME), NOT, AND, OR and parentheses; other conditions (hasattribute, hastype,
+// ...) are false, with a warning.
+bool Lexer::eval_condition(std::string_view expr, size_t at) {
+  size_t i = 0;
+  bool unknown = false;
+  auto skip_ws = [&] {
+    while (i < expr.size() && std::isspace(static_cast<unsigned char>(expr[i]))) ++i;
+  };
+  auto word = [&] {
+    skip_ws();
+    std::string w = upper_word(expr.substr(i));
+    return w;
+  };
+  // Recursive descent over a few levels; the depth is bounded by the pragma's length,
+  // which is bounded by the line, and a guard stops runaway nesting.
+  int depth = 0;
+  std::function<bool()> disj, conj, unary;
+  unary = [&]() -> bool {
+    if (++depth > 64) {
+      unknown = true;
+      i = expr.size();
+      return false;
+    }
+    skip_ws();
+    bool v = false;
+    std::string w = word();
+    if (w == "NOT") {
+      i += 3;
+      v = !unary();
+    } else if (i < expr.size() && expr[i] == '(') {
+      ++i;
+      v = disj();
+      skip_ws();
+      if (i < expr.size() && expr[i] == ')') ++i;
+    } else if (w == "DEFINED") {
+      i += w.size();
+      skip_ws();
+      if (i < expr.size() && expr[i] == '(') ++i;
+      skip_ws();
+      std::string name = upper_word(expr.substr(i));
+      i += name.size();
+      skip_ws();
+      if (i < expr.size() && expr[i] == ')') ++i;
+      v = std::find(defines_.begin(), defines_.end(), name) != defines_.end();
+    } else {
+      unknown = true;
+      // Skip the unknown operand: a name and a parenthesised argument list.
+      i += w.size();
+      skip_ws();
+      if (i < expr.size() && expr[i] == '(') {
+        int open = 0;
+        for (; i < expr.size(); ++i) {
+          if (expr[i] == '(') ++open;
+          if (expr[i] == ')' && --open == 0) {
+            ++i;
+            break;
+          }
+        }
+      } else if (w.empty()) {
+        i = expr.size();
+      }
+    }
+    --depth;
+    return v;
+  };
+  conj = [&]() -> bool {
+    bool v = unary();
+    while (word() == "AND") {
+      i += 3;
+      v = unary() && v;
+    }
+    return v;
+  };
+  disj = [&]() -> bool {
+    bool v = conj();
+    while (word() == "OR") {
+      i += 2;
+      v = conj() || v;
+    }
+    return v;
+  };
+  bool v = disj();
+  if (unknown)
+    diags_.warning("ST406", loc_at(at), "condition '" + std::string(expr) +
+                                            "': only defined(NAME), NOT, AND and OR are evaluated; the rest counts as FALSE");
+  return v;
+}
+
+// Text in a conditional branch not taken is skipped as text: comments and strings are
+// stepped over (a '{' in them is no pragma), up to the next pragma, which skip_trivia
+// then reads.
+void Lexer::skip_inactive() {
+  while (pos_ < text_.size() && !active()) {
+    const char c = text_[pos_];
+    if (c == '{') {
+      const size_t begin = pos_;
+      const size_t close = text_.find('}', pos_);
+      if (close == std::string_view::npos) {
+        error("ST011", begin, "unterminated pragma: '{' has no matching '}'");
+        pos_ = text_.size();
+        return;
+      }
+      pos_ = close + 1;
+      pragma(begin, close);
+    } else if (c == '/' && peek(1) == '/') {
+      while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+    } else if ((c == '(' || c == '/') && peek(1) == '*') {
+      const char close = c == '(' ? ')' : '/';
+      size_t e = text_.find(std::string{'*', close}, pos_ + 2);
+      pos_ = e == std::string_view::npos ? text_.size() : e + 2;
+    } else if (c == '\'' || c == '"') {
+      size_t e = pos_ + 1;
+      while (e < text_.size() && text_[e] != c && text_[e] != '\n') e += text_[e] == '$' ? 2 : 1;
+      pos_ = std::min(text_.size(), e + 1);
+    } else {
+      ++pos_;
     }
   }
 }

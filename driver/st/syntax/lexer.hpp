@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -30,6 +31,24 @@ class Lexer {
   Token lex_direct_address();
   Token lex_time_literal(size_t begin, std::string_view prefix);
   void error(std::string_view code, size_t offset, std::string message);
+  // A pragma `{...}` at [begin, end): conditional compilation ({IF defined(X)}, {ELSIF},
+  // {ELSE}, {END_IF}, {define X}, {undefine X}), the message pragmas ({warning '...'},
+  // {error '...'}, {info '...'}), and the ones that change nothing here (attribute,
+  // region, ...); any other is warned about and ignored.
+  void pragma(size_t begin, size_t end);
+  // Skips the text of a conditional branch not taken, up to the next pragma.
+  void skip_inactive();
+  bool eval_condition(std::string_view expr, size_t at);
+  bool active() const;
+
+  struct Cond {
+    bool active;      // this branch's text is compiled
+    bool taken;       // some branch of this IF was taken
+    bool outer;       // the enclosing text is compiled
+    size_t at;        // the {IF} (for an unterminated one)
+  };
+  std::vector<Cond> conds_;
+  std::vector<std::string> defines_;
 
   const SourceFile& src_;
   uint32_t file_;

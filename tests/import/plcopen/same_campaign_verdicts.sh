@@ -9,6 +9,7 @@ src=$2
 out=$3
 campaign=$src/faults/campaigns/stamping/campaign.yaml
 rm -rf "$out/st" "$out/xml"
+mkdir -p "$out"
 "$plcfi" campaign "$campaign" --out "$out/st" --quiet --no-vcd >"$out/st.log" 2>&1
 st_status=$?
 "$plcfi" campaign "$campaign" --program "$src/st_programs/stamping/stamping.xml" --out "$out/xml" --quiet --no-vcd \

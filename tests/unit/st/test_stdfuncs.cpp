@@ -101,10 +101,12 @@ class Conversions : public ::testing::Test {
     return conversion_kind(t(from), t(to), trunc);
   }
   // "from>to", with "-" for no source type and a leading "~" for TRUNC; "none" when not a conversion.
+  // "bcd<" / "bcd>" in front: decoding / encoding BCD.
   std::string parsed(std::string_view name) const {
     auto c = parse_conversion(tt, name);
     if (!c) return "none";
-    return std::string(c->trunc ? "~" : "") + (c->from ? c->from->name : "-") + ">" + c->to->name;
+    const char* bcd = c->bcd == ConversionName::Bcd::Decode ? "bcd<" : c->bcd == ConversionName::Bcd::Encode ? "bcd>" : "";
+    return std::string(bcd) + (c->trunc ? "~" : "") + (c->from ? c->from->name : "-") + ">" + c->to->name;
   }
   TypeTable tt;
 };
@@ -121,10 +123,23 @@ TEST_F(Conversions, NamesParseToTheirTypes) {
   EXPECT_EQ(parsed("DT_TO_DATE"), "DATE_AND_TIME>DATE");
   EXPECT_EQ(parsed("TOD_TO_STRING"), "TIME_OF_DAY>STRING");
   EXPECT_EQ(parsed("TIME_OF_DAY_TO_DT"), "TIME_OF_DAY>DATE_AND_TIME");
+  // TRUNC into a named type, from any or a named real type.
+  EXPECT_EQ(parsed("TRUNC_INT"), "~->INT");
+  EXPECT_EQ(parsed("REAL_TRUNC_INT"), "~REAL>INT");
+  EXPECT_EQ(parsed("LREAL_TRUNC_ULINT"), "~LREAL>ULINT");
+  // BCD: the standard's forms, the generic ones and the library-style INT_TO_BCD (into the
+  // bit string of the integer's width).
+  EXPECT_EQ(parsed("WORD_BCD_TO_UINT"), "bcd<WORD>UINT");
+  EXPECT_EQ(parsed("UINT_TO_BCD_WORD"), "bcd>UINT>WORD");
+  EXPECT_EQ(parsed("BCD_TO_INT"), "bcd<->INT");
+  EXPECT_EQ(parsed("TO_BCD_DWORD"), "bcd>->DWORD");
+  EXPECT_EQ(parsed("INT_TO_BCD"), "bcd>INT>WORD");
+  EXPECT_EQ(parsed("USINT_TO_BCD"), "bcd>USINT>BYTE");
 }
 
 TEST_F(Conversions, OtherNamesAreNoConversion) {
-  for (std::string_view n : {"FOO_TO_INT", "INT_TO_FOO", "TO_", "TO_FOO", "SQRT", "REAL_TRUNC_INT", "TRUNC_INT",
+  for (std::string_view n : {"FOO_TO_INT", "INT_TO_FOO", "TO_", "TO_FOO", "SQRT", "INT_TRUNC_INT", "TRUNC_REAL",
+                             "TRUNC_FOO", "REAL_BCD_TO_INT", "INT_TO_BCD_REAL", "BCD_TO_REAL", "REAL_TO_BCD",
                              "ADD_TIME", "CONCAT_DATE_TOD", "SUB_TOD_TOD", ""})
     EXPECT_EQ(parsed(n), "none") << n;
 }
