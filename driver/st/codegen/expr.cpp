@@ -168,7 +168,15 @@ bool Compiler::dialect_converts(const Type* from, const Type* to) const {
 // of that name would do (a REAL to an integer rounds).
 Val Compiler::implicit_conversion(const Val& v, const Type* to, SourceLoc loc, const char* what) {
   const Type* from = v.type;
-  bool narrowing = !implicitly_converts(to, from) || (from->is_real() && !to->is_real());
+  // Narrowing: some value of the source has no equal in the target.
+  auto is_signed = [](const Type* t) { return t->is_integer() && !t->is_unsigned_int(); };
+  bool narrowing;
+  if (to->kind == TypeKind::Bool) narrowing = true;
+  else if (from->kind == TypeKind::Bool) narrowing = false;
+  else if (from->is_real()) narrowing = !to->is_real() || to->size < from->size;
+  else if (to->is_real()) narrowing = from->size >= to->size;  // REAL holds 24 bits exactly, LREAL 53
+  else narrowing = to->size < from->size || (is_signed(from) && !is_signed(to)) ||
+                   (!is_signed(from) && is_signed(to) && to->size == from->size);
   std::string fn = canon(from->name) + "_TO_" + canon(to->name);
   std::string msg = fmt::format("implicit conversion from {} to {}{} ({}){}", from->name, to->name,
                                 what ? std::string(" in ") + what : std::string(), fn,
