@@ -154,6 +154,7 @@ Emitter emitter_of(StdFamily f) {
     case F::Replace: return &Compiler::emit_replace;
     case F::AddressOf: return &Compiler::emit_address_of;
     case F::SizeOf: return &Compiler::emit_sizeof;
+    case F::IsValidRef: return &Compiler::emit_is_valid_ref;
     case F::Now: return &Compiler::emit_now;
     case F::Temporal: return &Compiler::emit_temporal;
     case F::AdvanceTime: return &Compiler::emit_advance_time;
@@ -679,6 +680,24 @@ std::optional<Val> Compiler::emit_address_of(const StdFunc& f, const CallExpr& c
   Place p = place(*args[0], true);
   if (!p.ok) return bad();
   return slot_val(tt_->ref_to(p.type), addr_of(p, args[0]->loc));
+}
+
+// __ISVALIDREF(r): TRUE when the REFERENCE TO r is bound (looks at r itself, not its target).
+std::optional<Val> Compiler::emit_is_valid_ref(const StdFunc& f, const CallExpr& c) {
+  auto args = positional(c, f);
+  if (args.empty()) return bad();
+  Place p = place_ref(*args[0], false);
+  if (!p.ok) return bad();
+  if (!is_reference(p.type)) {
+    diags_.error("ST232", args[0]->loc, "__ISVALIDREF needs a REFERENCE TO, not " + p.type->name);
+    return bad();
+  }
+  Val ref = load(p);
+  Val null;
+  null.is_const = true;
+  null.type = null_type_;
+  null.c = ConstV{ConstV::K::Int, 0, 0, {}};
+  return combine(BinaryOp::Ne, ref, null, c.loc);
 }
 
 std::optional<Val> Compiler::emit_sizeof(const StdFunc& f, const CallExpr& c) {

@@ -224,6 +224,10 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
       store(frame_place(frame.plus(p->offset), elem(TypeKind::UDInt)), addr_of(src, a.value->loc));
       continue;
     }
+    if (is_reference(p->type)) {  // a REFERENCE TO input is bound to the argument
+      bind_reference(frame_place(frame.plus(p->offset), p->type), *a.value, a.value->loc);
+      continue;
+    }
     Val v = expr_for(*a.value, p->type);
     assign(frame_place(frame.plus(p->offset), p->type), v, a.value->loc);
   }
@@ -317,6 +321,10 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
         continue;
       }
       store(field, addr_of(src, a.value->loc));
+      continue;
+    }
+    if (is_reference(p->type)) {  // a REFERENCE TO input is bound to the argument
+      bind_reference(field, *a.value, a.value->loc);
       continue;
     }
     Val v = expr_for(*a.value, p->type);
@@ -475,6 +483,9 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
       if (!src.ok) continue;
       st.v.type = elem(TypeKind::UDInt);
       st.v.slot = addr_of(src, a->loc);
+    } else if (is_reference(p->type)) {  // a REFERENCE TO input is bound to the argument
+      st.v = reference_to_var(p->type, *a->value);
+      if (!st.v.ok) continue;
     } else {
       st.v = expr_for(*a->value, p->type);
       if (!st.v.ok) continue;

@@ -271,7 +271,19 @@ class Compiler {
   const Type* elem(TypeKind k) const { return tt_->elementary(k); }
 
   // ---- places, lvalues (places.cpp)
+  // The variable e denotes; a REFERENCE TO is followed to its target.
   Place place(const Expr& e, bool for_write);
+  // The same, but a REFERENCE TO is the reference itself (REF=, __ISVALIDREF, binding an input).
+  Place place_ref(const Expr& e, bool for_write);
+  // p, or the target of p when p is a REFERENCE TO (an unbound one traps at the access).
+  Place implicit_deref(const Place& p, SourceLoc loc);
+  // dst (a REFERENCE TO) REF= the variable e denotes; false after an error.
+  bool bind_reference(const Place& dst, const Expr& e, SourceLoc loc);
+  // The address of the variable e denotes, as a value of the reference type ref (REF=, and
+  // an argument for a REFERENCE TO input); bad() after an error (not a variable, a
+  // constant, another type).
+  Val reference_to_var(const Type* ref, const Expr& e);
+  static bool is_reference(const Type* t) { return t && t->kind == TypeKind::Ref && t->implicit_deref; }
   Place frame_place(Slot s, const Type* t) {
     Place p;
     p.k = Place::K::Frame;
@@ -325,6 +337,7 @@ class Compiler {
   std::optional<Val> emit_replace(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_address_of(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_sizeof(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_is_valid_ref(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_now(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_temporal(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_advance_time(const StdFunc& f, const CallExpr& c);

@@ -319,6 +319,19 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
       if (!spec.element) break;
       // REF_TO a type being declared (linked lists): resolve lazily through the entry.
       const Type* target = resolve_type(*spec.element, file);
+      if (spec.is_reference) {
+        if (opt_.dialect == Dialect::Iec) {
+          // Reported once here; the declaration still gets its type, so its uses add no errors.
+          diags_.error("ST241", spec.loc, "REFERENCE TO is CODESYS, not IEC 61131-3: declare a REF_TO and "
+                                          "dereference it with '^', or use --dialect codesys");
+        }
+        if (target && target->kind == TypeKind::Ref && target->implicit_deref) {
+          diags_.error("ST232", spec.loc, "a REFERENCE TO cannot refer to another REFERENCE TO");
+          break;
+        }
+        if (target) result = tt_->reference_to(target);
+        break;
+      }
       if (target) result = tt_->ref_to(target);
       break;
     }

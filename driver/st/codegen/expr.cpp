@@ -446,7 +446,7 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
             return property_get(Place{}, g, itf.slot, e.loc);
           }
         }
-        return load(member_place(base, m.member, e.loc));
+        return load(implicit_deref(member_place(base, m.member, e.loc), e.loc));
       }
       case ExprKind::DirectAddr:
       case ExprKind::Index:

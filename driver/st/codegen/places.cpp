@@ -85,7 +85,44 @@ Place Compiler::this_place(SourceLoc loc) {
 
 // ------------------------------------------------------------------ places
 
-Place Compiler::place(const Expr& e, bool for_write) {
+Place Compiler::place(const Expr& e, bool for_write) { return implicit_deref(place_ref(e, for_write), e.loc); }
+
+Place Compiler::implicit_deref(const Place& p, SourceLoc loc) {
+  if (!p.ok || !p.type || p.type->kind != TypeKind::Ref || !p.type->implicit_deref) return p;
+  Val ptr = load(p);
+  mark(loc);  // an unbound reference traps at this use
+  Place t = deref_place(ptr, p.type->target, loc);
+  t.sym = p.sym;
+  return t;
+}
+
+Val Compiler::reference_to_var(const Type* ref, const Expr& e) {
+  Place src = place(e, false);
+  if (!src.ok) return bad();
+  const Type* want = ref->target;
+  if (!same_type(src.type, want) && src.type != want && !derives(src.type, want)) {
+    diags_.error("ST203", e.loc, ref->name + " needs a variable of type " + want->name + ", not " + src.type->name);
+    return bad();
+  }
+  if (src.readonly) {
+    diags_.error("ST232", e.loc, (src.sym ? "'" + src.sym->name + "'" : std::string("this expression")) +
+                                     " is a constant: a reference to it would allow writing it");
+    return bad();
+  }
+  Val v;
+  v.type = ref;
+  v.slot = addr_of(src, e.loc);
+  return v;
+}
+
+bool Compiler::bind_reference(const Place& dst, const Expr& e, SourceLoc loc) {
+  Val v = reference_to_var(dst.type, e);
+  if (!v.ok) return false;
+  assign(dst, v, loc);
+  return true;
+}
+
+Place Compiler::place_ref(const Expr& e, bool for_write) {
   Place bad_place;
   bad_place.ok = false;
   switch (e.kind) {

@@ -213,7 +213,7 @@ void Compiler::assign_stmt(const AssignStmt& s) {
             return;
           }
         }
-        Place dst = member_place(base, m.member, s.lhs->loc);
+        Place dst = implicit_deref(member_place(base, m.member, s.lhs->loc), s.lhs->loc);
         if (!dst.ok) return;
         Val v = expr_for(*s.rhs, dst.type);
         if (s.is_ref_assign) {
@@ -238,7 +238,7 @@ void Compiler::assign_stmt(const AssignStmt& s) {
       }
     }
   }
-  Place dst = place(*s.lhs, true);
+  Place dst = s.is_ref_assign ? place_ref(*s.lhs, true) : place(*s.lhs, true);
   if (!dst.ok) {
     expr(*s.rhs);  // still check the right-hand side
     return;
@@ -249,16 +249,7 @@ void Compiler::assign_stmt(const AssignStmt& s) {
       diags_.error("ST232", s.loc, "REF= needs a reference on the left, not " + dst.type->name);
       return;
     }
-    Place src = place(*s.rhs, false);
-    if (!src.ok) return;
-    if (!same_type(src.type, dst.type->target) && src.type != dst.type->target) {
-      diags_.error("ST203", s.rhs->loc, "REF= needs a " + dst.type->target->name + ", not " + src.type->name);
-      return;
-    }
-    Val v;
-    v.type = dst.type;
-    v.slot = addr_of(src, s.rhs->loc);
-    assign(dst, v, s.loc);
+    bind_reference(dst, *s.rhs, s.loc);
     return;
   }
   Val v = expr_for(*s.rhs, dst.type);

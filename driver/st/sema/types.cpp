@@ -87,9 +87,21 @@ const Type* TypeTable::string_type(uint32_t len, bool wide) {
 
 const Type* TypeTable::ref_to(const Type* target) {
   for (const auto& t : owned_)
-    if (t->kind == TypeKind::Ref && t->target == target) return t.get();
+    if (t->kind == TypeKind::Ref && t->target == target && !t->implicit_deref) return t.get();
   Type* t = make(TypeKind::Ref, "REF_TO " + target->name);
   t->target = target;
+  t->size = 4;
+  t->align = 4;
+  t->init.assign(4, 0);
+  return t;
+}
+
+const Type* TypeTable::reference_to(const Type* target) {
+  for (const auto& t : owned_)
+    if (t->kind == TypeKind::Ref && t->target == target && t->implicit_deref) return t.get();
+  Type* t = make(TypeKind::Ref, "REFERENCE TO " + target->name);
+  t->target = target;
+  t->implicit_deref = true;
   t->size = 4;
   t->align = 4;
   t->init.assign(4, 0);

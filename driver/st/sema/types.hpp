@@ -61,6 +61,9 @@ struct Type {
   uint32_t str_len = 0;
   // Ref: target type.
   const Type* target = nullptr;
+  // Ref declared REFERENCE TO (CODESYS): every use of a variable of this type reaches
+  // the target; only REF= and __ISVALIDREF see the reference itself.
+  bool implicit_deref = false;
   // Pou / Interface:
   PouInfo* pou = nullptr;
   // Initial image of a value of this type (size bytes): defaults and declared initializers.
@@ -89,6 +92,7 @@ class TypeTable {
   const Type* by_name(std::string_view name) const;  // elementary names only (INT, TIME, ...)
   const Type* string_type(uint32_t len, bool wide);
   const Type* ref_to(const Type* target);
+  const Type* reference_to(const Type* target);  // REFERENCE TO target
   Type* make(TypeKind k, std::string name);  // a new user type, to be filled by the caller
   const Type* void_type() const { return elementary(TypeKind::Void); }
   const Type* null_ref() const { return null_; }  // the type of NULL: a reference to anything

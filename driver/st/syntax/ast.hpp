@@ -189,7 +189,7 @@ enum class TypeSpecKind {
   Struct,    // STRUCT ... END_STRUCT
   Enum,      // (A, B := 5, C)  or  INT (A := 1, B := 2)  or  (A, B) INT
   Subrange,  // INT (0..100)
-  Ref,       // REF_TO T (also POINTER TO T)
+  Ref,       // REF_TO T (also POINTER TO T, and REFERENCE TO T)
 };
 
 struct VarDecl;
@@ -217,6 +217,7 @@ struct TypeSpec {
   // Subrange:
   ExprPtr sub_lo, sub_hi;
   bool is_pointer = false;  // Ref spelt POINTER TO
+  bool is_reference = false;  // Ref spelt REFERENCE TO (CODESYS): dereferenced implicitly on every use
 };
 using TypeSpecPtr = std::unique_ptr<TypeSpec>;
 

@@ -203,7 +203,7 @@ std::string dump(const TypeSpec& t) {
     case TypeSpecKind::Subrange:
       return (t.element ? dump(*t.element) : std::string("_")) + " (" + opt(t.sub_lo) + ".." + opt(t.sub_hi) + ")";
     case TypeSpecKind::Ref:
-      return std::string(t.is_pointer ? "POINTER TO " : "REF_TO ") + (t.element ? dump(*t.element) : "_");
+      return std::string(t.is_reference ? "REFERENCE TO " : t.is_pointer ? "POINTER TO " : "REF_TO ") + (t.element ? dump(*t.element) : "_");
   }
   return "?";
 }

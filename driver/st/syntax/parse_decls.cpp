@@ -140,7 +140,7 @@ bool Parser::parse_var_decl(std::vector<VarDecl>& out, VarSection section, bool 
 
 // type_spec := ARRAY '[' range {',' range} ']' OF type_spec
 //            | STRUCT {var_decl} END_STRUCT
-//            | REF_TO type_spec | POINTER TO type_spec
+//            | REF_TO type_spec | POINTER TO type_spec | REFERENCE TO type_spec
 //            | '(' enum_value {',' enum_value} ')' [name]
 //            | (STRING | WSTRING) ['[' expr ']' | '(' expr ')']
 //            | name ['(' enum_value {',' enum_value} ')' | '(' expr '..' expr ')']
@@ -199,10 +199,13 @@ TypeSpecPtr Parser::parse_type_spec() {
     }
     return spec;
   }
-  if (at(Tok::RefTo) || (at_word("POINTER") && la(1).kind == Tok::To)) {
-    spec->is_pointer = !at(Tok::RefTo);
+  // REFERENCE TO is parsed in every dialect; the compiler rejects it under --dialect iec.
+  if (at(Tok::RefTo) || ((at_word("POINTER") || at_word("REFERENCE")) && la(1).kind == Tok::To)) {
+    spec->is_reference = at_word("REFERENCE");
+    spec->is_pointer = !at(Tok::RefTo) && !spec->is_reference;
+    const bool two_words = !at(Tok::RefTo);
     advance();
-    if (spec->is_pointer) advance();
+    if (two_words) advance();
     spec->kind = TypeSpecKind::Ref;
     spec->element = parse_type_spec();
     return spec;

@@ -314,6 +314,67 @@ TEST(Compiler, GenericFunctionOfLiteralsAdaptsToTheTarget) {
   EXPECT_EQ(0u, b->diags.error_count()) << b->diags.render_all();
 }
 
+// CODESYS references (REFERENCE TO): misuse the codesys suite's files cannot show, as the
+// negative suite checks without a dialect.
+CompileOptions codesys() {
+  CompileOptions opt;
+  opt.dialect = Dialect::Codesys;
+  return opt;
+}
+
+TEST(CodesysReference, BindingToAConstantIsAnError) {
+  auto b = compile_one("PROGRAM Main\nVAR CONSTANT k : INT := 3; END_VAR\nVAR r : REFERENCE TO INT; END_VAR\n"
+                       "r REF= k;\nEND_PROGRAM\n", codesys());
+  EXPECT_FALSE(b->ok());
+  ASSERT_EQ(1u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST232", b->diags.all()[0].code);
+  EXPECT_EQ(4u, b->diags.all()[0].loc.line);
+  EXPECT_NE(std::string::npos, b->diags.all()[0].message.find("'k' is a constant")) << b->diags.all()[0].message;
+}
+
+TEST(CodesysReference, BindingToALiteralOrAnotherTypeIsAnError) {
+  auto b = compile_one("PROGRAM Main\nVAR r : REFERENCE TO INT; d : DINT; END_VAR\n"
+                       "r REF= 5;\nr REF= d;\nEND_PROGRAM\n", codesys());
+  ASSERT_EQ(2u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST206", b->diags.all()[0].code);
+  EXPECT_EQ("ST203", b->diags.all()[1].code);
+  EXPECT_NE(std::string::npos, b->diags.all()[1].message.find("REFERENCE TO INT needs a variable of type INT, not DINT"));
+}
+
+TEST(CodesysReference, IsValidRefNeedsAReference) {
+  auto b = compile_one("PROGRAM Main\nVAR i : INT; ok : BOOL; END_VAR\nok := __ISVALIDREF(i);\nEND_PROGRAM\n", codesys());
+  ASSERT_EQ(1u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST232", b->diags.all()[0].code);
+}
+
+TEST(CodesysReference, IecRejectsEachDeclarationOnce) {
+  auto b = compile_one("PROGRAM Main\nVAR x : INT; r : REFERENCE TO INT; END_VAR\nr REF= x;\nr := r + 1;\nEND_PROGRAM\n");
+  ASSERT_EQ(1u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST241", b->diags.all()[0].code);
+  EXPECT_EQ(2u, b->diags.all()[0].loc.line);
+  EXPECT_EQ(18u, b->diags.all()[0].loc.col);
+}
+
+TEST(CodesysReference, UnboundUseTrapsAtTheUse) {
+  auto b = compile_one("PROGRAM Main\nVAR x : INT; r : REFERENCE TO INT; bind : BOOL; y : INT; END_VAR\n"
+                       "IF bind THEN r REF= x; END_IF\nx := 41;\ny := r + 1;\nEND_PROGRAM\n", codesys());
+  ASSERT_TRUE(b->ok()) << b->diags.render_all();
+  Machine m(*b->app);
+  const auto& p = b->app->programs.at(0);
+  EXPECT_FALSE(m.call(p.pou->entry, p.addr));
+  EXPECT_EQ(TrapKind::NullReference, m.trap().kind);
+  EXPECT_EQ(5u, m.trap().loc.line);
+  EXPECT_EQ(6u, m.trap().loc.col);
+  std::string err;
+  auto bind = resolve(*b->app, "Main.bind", &err);
+  ASSERT_TRUE(bind) << err;
+  write_int(m, *bind, 1);
+  EXPECT_TRUE(m.call(p.pou->entry, p.addr));
+  auto y = resolve(*b->app, "Main.y", &err);
+  ASSERT_TRUE(y) << err;
+  EXPECT_EQ(42, read_int(m, *y));
+}
+
 }  // namespace
 }  // namespace plcfi::st
 
