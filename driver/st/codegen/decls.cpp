@@ -245,7 +245,10 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
       break;
     }
     case TypeSpecKind::Struct: {
-      Type* t = tt_->make(TypeKind::Struct, name_hint.empty() ? "STRUCT" : name_hint);
+      if (spec.is_union && opt_.dialect == Dialect::Iec)
+        diags_.error("ST241", spec.loc, "UNION is CODESYS, not IEC 61131-3: declare a STRUCT, or use --dialect codesys");
+      Type* t = tt_->make(TypeKind::Struct, name_hint.empty() ? (spec.is_union ? "UNION" : "STRUCT") : name_hint);
+      t->is_union = spec.is_union;
       // Registered before its members so a member REF_TO the struct itself resolves.
       if (!name_hint.empty()) {
         auto it = types_.find(canon(name_hint));
@@ -363,9 +366,25 @@ void Compiler::layout_struct(Type* t, const std::vector<VarDecl>& members, uint3
                                              " (use REF_TO for a link back)");
       continue;
     }
+    if (t->is_union && (held->kind == TypeKind::Pou || held->kind == TypeKind::Interface)) {
+      // An instance shares no storage: its state and hidden fields would be overwritten.
+      diags_.error("ST201", d.type->loc, "a UNION cannot hold " + std::string(held->kind == TypeKind::Pou ? "function block instances" : "interface references") +
+                                             " ('" + held->name + "'): use a STRUCT");
+      continue;
+    }
+    if (t->is_union && d.init && !t->fields.empty())
+      diags_.error("ST209", d.init->loc, "only the first member of a UNION can have an initial value (it and "
+                                         "the others share their storage)");
     for (const auto& n : d.names) {
       if (!names.insert(canon(n.text)).second) {
         diags_.error("ST202", n.loc, "member '" + n.text + "' is declared twice");
+        continue;
+      }
+      if (t->is_union) {  // every member at offset 0; the union is as large as its largest
+        t->fields.push_back(Field{n.text, ft, 0, n.loc});
+        if (t->fields.size() == 1) inits.push_back({0, ft, d.init.get()});
+        off = std::max(off, ft->size);
+        align = std::max(align, ft->align);
         continue;
       }
       off = align_up(off, ft->align);
@@ -685,7 +704,13 @@ void Compiler::write_init(std::vector<uint8_t>& image, uint32_t offset, const Ty
       diags_.error("ST203", init->loc, "a structure initializer needs a structure or FB instance, not " + t->name);
       return;
     }
-    for (const auto& item : static_cast<const StructInitExpr&>(*init).items) {
+    const auto& items = static_cast<const StructInitExpr&>(*init).items;
+    if (t->is_union && !t->fields.empty() &&
+        (items.size() > 1 || (items.size() == 1 && !iequals(items[0].field.text, t->fields[0].name)))) {
+      diags_.error("ST209", init->loc, "a UNION initializer sets its first member only: (" + t->fields[0].name + " := ...)");
+      return;
+    }
+    for (const auto& item : items) {
       const Field* f = t->field(item.field.text);
       if (!f) {
         diags_.error("ST207", item.field.loc, "'" + t->name + "' has no member '" + item.field.text + "'");

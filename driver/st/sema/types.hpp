@@ -54,6 +54,7 @@ struct Type {
   std::vector<Dim> dims;
   // Struct: members.
   std::vector<Field> fields;
+  bool is_union = false;  // UNION (CODESYS): every field at offset 0, the size of the largest
   // Enum: base integer type and values.
   const Type* base = nullptr;
   std::vector<std::pair<std::string, int64_t>> enum_values;

@@ -186,7 +186,7 @@ struct StructInitExpr : Expr {
 enum class TypeSpecKind {
   Named,     // INT, MyStruct, STRING, STRING[20], STRING(20), WSTRING[10]
   Array,     // ARRAY [1..10, 0..2] OF T   (ARRAY[*] not supported)
-  Struct,    // STRUCT ... END_STRUCT
+  Struct,    // STRUCT ... END_STRUCT (also UNION ... END_UNION, is_union)
   Enum,      // (A, B := 5, C)  or  INT (A := 1, B := 2)  or  (A, B) INT
   Subrange,  // INT (0..100)
   Ref,       // REF_TO T (also POINTER TO T, and REFERENCE TO T)
@@ -217,6 +217,7 @@ struct TypeSpec {
   // Subrange:
   ExprPtr sub_lo, sub_hi;
   bool is_pointer = false;  // Ref spelt POINTER TO
+  bool is_union = false;      // Struct spelt UNION ... END_UNION (CODESYS): every member at offset 0
   bool is_reference = false;  // Ref spelt REFERENCE TO (CODESYS): dereferenced implicitly on every use
 };
 using TypeSpecPtr = std::unique_ptr<TypeSpec>;

@@ -179,7 +179,7 @@ std::string dump(const TypeSpec& t) {
       return s + "] OF " + (t.element ? dump(*t.element) : "_");
     }
     case TypeSpecKind::Struct: {
-      std::string s = "STRUCT";
+      std::string s = t.is_union ? "UNION" : "STRUCT";
       for (const auto& m : t.members) {
         s += " ";
         for (size_t i = 0; i < m.names.size(); ++i) s += (i ? "," : "") + m.names[i].text;
@@ -187,7 +187,7 @@ std::string dump(const TypeSpec& t) {
         if (m.init) s += ":=" + dump(*m.init);
         s += ";";
       }
-      return s + " END_STRUCT";
+      return s + (t.is_union ? " END_UNION" : " END_STRUCT");
     }
     case TypeSpecKind::Enum: {
       std::string s = "(";

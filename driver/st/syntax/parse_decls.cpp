@@ -139,7 +139,7 @@ bool Parser::parse_var_decl(std::vector<VarDecl>& out, VarSection section, bool 
 }
 
 // type_spec := ARRAY '[' range {',' range} ']' OF type_spec
-//            | STRUCT {var_decl} END_STRUCT
+//            | STRUCT {var_decl} END_STRUCT | UNION {var_decl} END_UNION
 //            | REF_TO type_spec | POINTER TO type_spec | REFERENCE TO type_spec
 //            | '(' enum_value {',' enum_value} ')' [name]
 //            | (STRING | WSTRING) ['[' expr ']' | '(' expr ')']
@@ -175,11 +175,18 @@ TypeSpecPtr Parser::parse_type_spec() {
     spec->element = parse_type_spec();
     return spec;
   }
-  if (at(Tok::Struct)) {
+  // UNION is parsed in every dialect; the compiler rejects it under --dialect iec.
+  if (at(Tok::Struct) || at_word("UNION")) {
+    spec->is_union = !at(Tok::Struct);
+    const char* opener = spec->is_union ? "UNION" : "STRUCT";
+    const char* closer = spec->is_union ? "END_UNION" : "END_STRUCT";
     advance();
     spec->kind = TypeSpecKind::Struct;
     for (;;) {
-      if (accept(Tok::EndStruct)) break;
+      if (spec->is_union ? at_word("END_UNION") : at(Tok::EndStruct)) {
+        advance();
+        break;
+      }
       if (at(Tok::Ident)) {
         const size_t before = pos_;
         parse_var_decl(spec->members, VarSection::Var, false);
@@ -187,9 +194,9 @@ TypeSpecPtr Parser::parse_type_spec() {
         continue;
       }
       if (at_terminator() || is_stmt_keyword(cur().kind)) {
-        Diagnostic* d = error("ST124", cur().loc, "expected END_STRUCT to close STRUCT at line " +
+        Diagnostic* d = error("ST124", cur().loc, std::string("expected ") + closer + " to close " + opener + " at line " +
                                                       std::to_string(t.loc.line) + ", found " + describe(cur()));
-        if (d) d->notes.emplace_back(t.loc, "STRUCT starts here");
+        if (d) d->notes.emplace_back(t.loc, std::string(opener) + " starts here");
         break;
       }
       error("ST121", cur().loc, "expected a member declaration such as 'x : INT;', found " + describe(cur()));

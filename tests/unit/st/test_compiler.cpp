@@ -375,6 +375,37 @@ TEST(CodesysReference, UnboundUseTrapsAtTheUse) {
   EXPECT_EQ(42, read_int(m, *y));
 }
 
+// CODESYS unions: misuse (the negative suite checks without a dialect, where UNION itself
+// is the error).
+TEST(CodesysUnion, AFunctionBlockMemberIsAnError) {
+  auto b = compile_one("TYPE U :\nUNION\n  i : INT;\n  t : TON;\nEND_UNION\nEND_TYPE\n"
+                       "PROGRAM Main\nVAR u : U; END_VAR\nu.i := 1;\nEND_PROGRAM\n", codesys());
+  ASSERT_EQ(1u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST201", b->diags.all()[0].code);
+  EXPECT_EQ(4u, b->diags.all()[0].loc.line);
+  EXPECT_NE(std::string::npos, b->diags.all()[0].message.find("a UNION cannot hold function block instances"));
+}
+
+TEST(CodesysUnion, OnlyTheFirstMemberIsInitialized) {
+  auto b = compile_one("TYPE U :\nUNION\n  i : INT;\n  b : BYTE := 3;\nEND_UNION\nEND_TYPE\n"
+                       "PROGRAM Main\nVAR u : U; v : U := (b := 1); w : U := (i := 2); END_VAR\nu.i := 1;\nEND_PROGRAM\n",
+                       codesys());
+  ASSERT_EQ(2u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST209", b->diags.all()[0].code);
+  EXPECT_EQ(4u, b->diags.all()[0].loc.line);
+  EXPECT_EQ("ST209", b->diags.all()[1].code);
+  EXPECT_EQ(8u, b->diags.all()[1].loc.line);
+  EXPECT_NE(std::string::npos, b->diags.all()[1].message.find("(i := ...)"));
+}
+
+TEST(CodesysUnion, IecRejectsEachUnionOnce) {
+  auto b = compile_one("TYPE U :\nUNION\n  i : INT;\n  b : BYTE;\nEND_UNION\nEND_TYPE\n"
+                       "PROGRAM Main\nVAR u : U; END_VAR\nu.b := 1;\nEND_PROGRAM\n");
+  ASSERT_EQ(1u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST241", b->diags.all()[0].code);
+  EXPECT_EQ(2u, b->diags.all()[0].loc.line);
+}
+
 }  // namespace
 }  // namespace plcfi::st
 
