@@ -185,6 +185,8 @@ class Compiler {
   const Type* named_type(const Ident& name, uint32_t file, bool report = true);
   void layout_struct(Type* t, const std::vector<VarDecl>& members, uint32_t file);
   void declare_vars(PouInfo* p);
+  // The name under which a method's VAR_INST variable is kept in its owner's instance.
+  static std::string inst_var_name(const PouInfo* method, const std::string& var);
   void declare_globals(const std::vector<VarBlock>& blocks, const std::string& scope, uint32_t file);
   std::optional<ConstV> const_eval(const Expr& e, uint32_t file, bool report = true);
   // `Colour.Red`: an enumeration value qualified by its type's name (CODESYS, TwinCAT),

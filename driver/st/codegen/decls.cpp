@@ -840,6 +840,10 @@ void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::s
   }
 }
 
+std::string Compiler::inst_var_name(const PouInfo* method, const std::string& var) {
+  return method->owner->name + "." + method->name + "." + var;
+}
+
 // Creates the symbols of a POU's variables and lays out its instance or frame.
 void Compiler::declare_vars(PouInfo* p) {
   const PouInfo* saved_decl_pou = decl_pou_;
@@ -893,8 +897,11 @@ void Compiler::declare_vars(PouInfo* p) {
   };
   // Parameters first (their order is the calling convention), then result, then the rest.
   static constexpr VarSection kOrder[] = {VarSection::Input, VarSection::InOut, VarSection::Output,
-                                          VarSection::Var,   VarSection::Stat,  VarSection::External,
-                                          VarSection::Global, VarSection::Config, VarSection::Temp};
+                                          VarSection::Var,   VarSection::Stat,  VarSection::Inst,
+                                          VarSection::External, VarSection::Global, VarSection::Config,
+                                          VarSection::Temp};
+  // A method's VAR_INST lives in its owner's instance: the owner is laid out first.
+  if (p->kind == PouKind::Method && p->owner) declare_pou(p->owner);
   bool is_callable = p->kind == PouKind::Function || p->kind == PouKind::Method;
   for (VarSection sec : kOrder) {
     if (is_callable && sec == VarSection::Output) {
@@ -933,6 +940,26 @@ void Compiler::declare_vars(PouInfo* p) {
           continue;
         }
         if (sec == VarSection::Config) continue;
+        if ((sec == VarSection::Stat || (sec == VarSection::Inst && p->kind == PouKind::Method)) &&
+            opt_.dialect == Dialect::Iec &&
+            &d == &blk.decls.front())  // once per block
+          diags_.error("ST241", blk.loc, sec == VarSection::Stat
+                                             ? "VAR_STAT is CODESYS, not IEC 61131-3: declare a VAR_GLOBAL, or use --dialect codesys"
+                                             : "VAR_INST is CODESYS, not IEC 61131-3: declare the variable in the method's "
+                                               "function block or program, or use --dialect codesys");
+        if (sec == VarSection::Inst) {
+          // Laid out by the owner (see below): here the method's name for that storage.
+          if (p->kind != PouKind::Method || !p->owner) continue;  // the parser reported it
+          for (const auto& n : d.names) {
+            Symbol* kept = p->owner->find_var(inst_var_name(p, n.text));
+            if (!kept) continue;  // its type did not resolve: reported with the owner
+            Symbol* s = add(d, n, kept->type);
+            if (!s) continue;
+            s->where = Where::This;
+            s->offset = kept->offset;
+          }
+          continue;
+        }
         if (sec == VarSection::External) {
           for (const auto& n : d.names) {
             auto it = globals_.find(canon(n.text));
@@ -988,6 +1015,11 @@ void Compiler::declare_vars(PouInfo* p) {
           if (sec == VarSection::InOut) {
             place_var(s, 4, 4);
             s->where = Where::InOut;
+          } else if (sec == VarSection::Stat) {
+            // One per POU, shared by every instance and call: laid out like a global.
+            s->where = Where::Abs;
+            s->offset = alloc(t->size, t->align);
+            write_init(app_->init_image, s->offset, t, d.init.get(), p->file);
           } else {
             place_var(s, t->size, t->align);
           }
@@ -998,6 +1030,27 @@ void Compiler::declare_vars(PouInfo* p) {
       }
     }
   }
+  // The VAR_INST of its methods: kept in this instance under a name no source can spell
+  // (Owner.Method.x), so the body does not see them; each method reaches its own through THIS.
+  if (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program)
+    for (const auto& m : p->methods)
+      for (const VarBlock* blkp : src(m.get()).blocks) {
+        if (blkp->section != VarSection::Inst) continue;
+        for (const auto& d : blkp->decls) {
+          const Type* t = d.type ? resolve_type(*d.type, m->file) : nullptr;
+          if (!t) continue;
+          if (t->kind == TypeKind::Pou && t->pou == p) {
+            diags_.error("ST240", d.loc, p->name + " cannot contain an instance of itself");
+            continue;
+          }
+          for (const auto& n : d.names) {
+            Symbol* s = add(d, Ident{inst_var_name(m.get(), n.text), n.loc}, t);
+            if (!s) continue;
+            sym_src(s).reads = 1;  // used by the method, through its own symbol
+            place_var(s, t->size, t->align);
+          }
+        }
+      }
   p->frame_size = align_up(off, 8);
   decl_pou_ = saved_decl_pou;
   // A variable of an FB and one of its methods or properties spelt alike would each hide

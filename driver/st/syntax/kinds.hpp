@@ -16,7 +16,8 @@ enum class VarSection {
   Temp,       // VAR_TEMP
   Global,     // VAR_GLOBAL
   External,   // VAR_EXTERNAL
-  Stat,       // VAR_STAT (treated as VAR)
+  Stat,       // VAR_STAT (CODESYS): one variable per POU, shared by its instances and calls
+  Inst,       // VAR_INST (CODESYS): a METHOD's variable kept in its FB instance between calls
   Config,     // VAR_CONFIG (parsed, not used)
 };
 

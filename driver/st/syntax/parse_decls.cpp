@@ -42,6 +42,7 @@ VarBlock Parser::parse_var_block() {
     case Tok::VarGlobal: block.section = VarSection::Global; break;
     case Tok::VarExternal: block.section = VarSection::External; break;
     case Tok::VarStat: block.section = VarSection::Stat; break;
+    case Tok::VarInst: block.section = VarSection::Inst; break;
     case Tok::VarConfig: block.section = VarSection::Config; break;
     default: block.section = VarSection::Var; break;
   }
@@ -387,6 +388,10 @@ void Parser::parse_pou_body(Pou& pou, bool allow_members) {
       if (seen_statements)
         error("ST129", cur().loc, "variable declarations must come before the statements of " +
                                       std::string(pou_keyword(pou.kind)) + " '" + pou.name.text + "'");
+      if (at(Tok::VarInst) && pou.kind != PouKind::Method)
+        error("ST129", cur().loc, "VAR_INST is only allowed in a METHOD (a variable of the method kept in its "
+                                  "function block's instance), not in " + std::string(pou_keyword(pou.kind)) + " '" +
+                                  pou.name.text + "'");
       pou.var_blocks.push_back(parse_var_block());
     } else if (at(Tok::Method) || at(Tok::Property)) {
       if (!allow_members) {

@@ -29,7 +29,7 @@ inline constexpr int kMaxDepth = 128;
 inline bool is_var_keyword(Tok k) {
   switch (k) {
     case Tok::Var: case Tok::VarInput: case Tok::VarOutput: case Tok::VarInOut: case Tok::VarTemp:
-    case Tok::VarGlobal: case Tok::VarExternal: case Tok::VarStat: case Tok::VarConfig:
+    case Tok::VarGlobal: case Tok::VarExternal: case Tok::VarStat: case Tok::VarInst: case Tok::VarConfig:
       return true;
     default:
       return false;

@@ -41,6 +41,7 @@ namespace plcfi::st {
   X(VarGlobal, "VAR_GLOBAL")                                  \
   X(VarExternal, "VAR_EXTERNAL")                              \
   X(VarStat, "VAR_STAT")                                      \
+  X(VarInst, "VAR_INST")                                      \
   X(VarConfig, "VAR_CONFIG")                                  \
   X(EndVar, "END_VAR")                                        \
   X(Constant, "CONSTANT")                                     \

@@ -406,6 +406,32 @@ TEST(CodesysUnion, IecRejectsEachUnionOnce) {
   EXPECT_EQ(2u, b->diags.all()[0].loc.line);
 }
 
+// VAR_INST and VAR_STAT: misuse (the negative suite checks without a dialect).
+TEST(CodesysInstanceVars, VarInstInAFunctionIsOneError) {
+  auto b = compile_one("FUNCTION F : INT\nVAR_INST n : INT; END_VAR\nn := n + 1;\nF := n;\nEND_FUNCTION\n", codesys());
+  ASSERT_EQ(1u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST129", b->diags.all()[0].code);
+  EXPECT_EQ(2u, b->diags.all()[0].loc.line);
+}
+
+TEST(CodesysInstanceVars, AMethodsVarInstIsNotAVariableOfTheBlock) {
+  auto b = compile_one("FUNCTION_BLOCK Fb\nMETHOD M : INT\nVAR_INST n : INT; END_VAR\nn := n + 1;\nM := n;\nEND_METHOD\n"
+                       "n := 1;\nEND_FUNCTION_BLOCK\n", codesys());
+  ASSERT_EQ(1u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST200", b->diags.all()[0].code);
+  EXPECT_EQ(7u, b->diags.all()[0].loc.line);
+}
+
+TEST(CodesysInstanceVars, IecRejectsEachBlockOnce) {
+  auto b = compile_one("FUNCTION F : INT\nVAR_STAT a, b : INT; c : INT; END_VAR\nF := a + b + c;\nEND_FUNCTION\n"
+                       "FUNCTION_BLOCK Fb\nMETHOD M : INT\nVAR_INST n : INT; END_VAR\nM := n;\nEND_METHOD\nEND_FUNCTION_BLOCK\n");
+  ASSERT_EQ(2u, b->diags.error_count()) << b->diags.render_all();
+  EXPECT_EQ("ST241", b->diags.all()[0].code);
+  EXPECT_EQ(2u, b->diags.all()[0].loc.line);
+  EXPECT_EQ("ST241", b->diags.all()[1].code);
+  EXPECT_EQ(7u, b->diags.all()[1].loc.line);
+}
+
 }  // namespace
 }  // namespace plcfi::st
 
