@@ -624,9 +624,13 @@ const char* trap_code(TrapKind k) {
   }
 }
 
-std::string describe_trap(const Application& app, const Trap& t) {
-  return fmt::format("{}: runtime error[{}]: {}{}", app.where(t.loc), trap_code(t.kind), trap_name(t.kind),
+std::string describe_trap_kind(const Trap& t) {
+  return fmt::format("runtime error[{}]: {}{}", trap_code(t.kind), trap_name(t.kind),
                      t.message.empty() || t.message == trap_name(t.kind) ? "" : ": " + t.message);
+}
+
+std::string describe_trap(const Application& app, const Trap& t) {
+  return app.where(t.loc) + ": " + describe_trap_kind(t);
 }
 
 }  // namespace plcfi::st

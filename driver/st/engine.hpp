@@ -83,6 +83,9 @@ std::string coverage_report(const Application& app, const std::vector<uint64_t>&
 
 // `file:line:col: runtime error[ST5nn]: message` for a trap.
 std::string describe_trap(const Application& app, const Trap& t);
+// The same without the location: `runtime error[ST5nn]: message` (for output that shows
+// the location already).
+std::string describe_trap_kind(const Trap& t);
 const char* trap_code(TrapKind k);
 
 }  // namespace plcfi::st

@@ -21,13 +21,17 @@ std::vector<TestResult> run_tests(const Application& app, Machine& m, const Test
       if (!m.call(entry, t.instance_addr)) {
         const Trap& tr = m.trap();
         r.where = app.where(tr.loc);
-        r.message = tr.kind == TrapKind::AssertFailed ? tr.message : std::string(what) + ": " + describe_trap(app, tr);
+        // The result is shown after its location (r.where); SETUP and TEARDOWN say which
+        // phase the trap came from.
+        r.message = tr.kind == TrapKind::AssertFailed ? tr.message
+                    : what                             ? std::string(what) + ": " + describe_trap_kind(tr)
+                                                       : describe_trap_kind(tr);
         return false;
       }
       return true;
     };
     if (t.has_setup) ok = phase(t.setup_entry, "in SETUP");
-    if (ok) ok = phase(t.body_entry, "runtime error");
+    if (ok) ok = phase(t.body_entry, nullptr);
     if (t.has_teardown) {
       bool td = phase(t.teardown_entry, "in TEARDOWN");
       if (ok && !td) ok = false;
