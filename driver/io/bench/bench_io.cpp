@@ -55,34 +55,28 @@ uint32_t BenchIo::output_extent() const {
   return e;
 }
 
-bool BenchIo::read(uint8_t* inputs, int64_t now_ns) {
+// Every part does `op`; false if any failed, with the last failure's error kept.
+template <typename Op>
+bool BenchIo::each_part(Op op) {
   bool ok = true;
   for (auto* p : parts_)
-    if (!p->read(inputs, now_ns)) {
+    if (!op(*p)) {
       ok = false;
       error_ = p->last_error();
     }
   return ok;
+}
+
+bool BenchIo::read(uint8_t* inputs, int64_t now_ns) {
+  return each_part([&](rt::IoBackend& p) { return p.read(inputs, now_ns); });
 }
 
 bool BenchIo::write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) {
-  bool ok = true;
-  for (auto* p : parts_)
-    if (!p->write(outputs, now_ns, dt_ns)) {
-      ok = false;
-      error_ = p->last_error();
-    }
-  return ok;
+  return each_part([&](rt::IoBackend& p) { return p.write(outputs, now_ns, dt_ns); });
 }
 
 bool BenchIo::write_final(const uint8_t* outputs, int64_t now_ns) {
-  bool ok = true;
-  for (auto* p : parts_)
-    if (!p->write_final(outputs, now_ns)) {
-      ok = false;
-      error_ = p->last_error();
-    }
-  return ok;
+  return each_part([&](rt::IoBackend& p) { return p.write_final(outputs, now_ns); });
 }
 
 std::vector<std::string> BenchIo::link_devices() const {

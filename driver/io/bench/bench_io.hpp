@@ -48,6 +48,8 @@ class BenchIo final : public rt::IoBackend {
  private:
   BenchIo() = default;
   IoConfig cfg_;
+  template <typename Op>
+  bool each_part(Op op);
   std::vector<rt::IoBackend*> parts_;
   std::unique_ptr<ModbusBackend> modbus_;
   std::unique_ptr<GpioBackend> gpio_;
