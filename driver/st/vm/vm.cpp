@@ -667,7 +667,8 @@ bool Machine::do_assert(const uint32_t* pc, uint8_t* base) {
       double y = vk == ValueKind::F32 ? ld<float>(b) : ld<double>(b);
       double tol = ld<double>(base + pc[4]);
       ok = std::fabs(x - y) <= tol;
-      if (!ok) msg = fmt::format("expected {} +/- {}, actual {}", x, tol, y);
+      // ASSERT_NEAR(actual, expected, tol), like ASSERT_EQ(actual, expected).
+      if (!ok) msg = fmt::format("expected {} +/- {}, actual {}", y, tol, x);
       break;
     }
     case AssertKind::Called:
@@ -698,8 +699,10 @@ bool Machine::do_assert(const uint32_t* pc, uint8_t* base) {
         default: break;
       }
       if (!ok) {
+        // ASSERT_EQ(actual, expected): the test-file format puts the value under test
+        // first (ASSERT_EQ(uut.count, 3)).
         if (kind == AssertKind::Eq)
-          msg = fmt::format("expected {}, actual {}", format_value(vk, a), format_value(vk, b));
+          msg = fmt::format("expected {}, actual {}", format_value(vk, b), format_value(vk, a));
         else
           msg = fmt::format("expected {} {} {}", format_value(vk, a), rel, format_value(vk, b));
       }

@@ -317,7 +317,7 @@ def generate(topic, what, outers, extra_src, head):
       t = [f"TEST '{odesc} with {idesc} in each argument'", "VAR h : Harness; END_VAR"]
       for p, val in enumerate(exp):
         where = POS[p] if npos == 3 else "value"
-        t.append(f"ASSERT_EQ(LINT#{val}, h.{name}({p + 1}), '{where} argument');")
+        t.append(f"ASSERT_EQ(h.{name}({p + 1}), LINT#{val}, '{where} argument');")
       t += ["END_TEST", ""]
       tests += t
   src.append("END_FUNCTION_BLOCK")
@@ -350,37 +350,37 @@ HEAD = ("""(* test_nested_calls.st: a call in an argument of a METHOD call or a 
 
 TEST 'a PROPERTY getter in the second argument of a METHOD'
 VAR c : Counter1; END_VAR
-ASSERT_EQ(501, c.M(a := 5, b := c.Count));
-ASSERT_EQ(501, c.M(5, c.Count));
-ASSERT_EQ(105, c.M(a := c.Count, b := 5));
+ASSERT_EQ(c.M(a := 5, b := c.Count), 501);
+ASSERT_EQ(c.M(5, c.Count), 501);
+ASSERT_EQ(c.M(a := c.Count, b := 5), 105);
 END_TEST
 
 TEST 'the same METHOD nested in itself'
 VAR c : Counter1; END_VAR
-ASSERT_EQ(10201, c.M(a := c.M(a := 1, b := 2), b := c.Count));
-ASSERT_EQ(10201, c.M(a := c.M(a := 1, b := 2), b := c.M(a := 0, b := c.Count)));
-ASSERT_EQ(1010201, c.M(a := c.M(a := c.M(a := 1, b := c.Count), b := c.M(a := 0, b := 2)), b := c.Count));
+ASSERT_EQ(c.M(a := c.M(a := 1, b := 2), b := c.Count), 10201);
+ASSERT_EQ(c.M(a := c.M(a := 1, b := 2), b := c.M(a := 0, b := c.Count)), 10201);
+ASSERT_EQ(c.M(a := c.M(a := c.M(a := 1, b := c.Count), b := c.M(a := 0, b := 2)), b := c.Count), 1010201);
 END_TEST
 
 TEST 'arguments are read left to right, each in its turn'
 VAR h : Harness; w : Worker; i : IWork; f : FB3; x : DINT; END_VAR
 i := w;
 x := 5;
-ASSERT_EQ(50006, F3(a := x, b := IncX(x), c := x), 'FUNCTION');
+ASSERT_EQ(F3(a := x, b := IncX(x), c := x), 50006, 'FUNCTION');
 x := 5;
-ASSERT_EQ(50006, w.M3(a := x, b := IncX(x), c := x), 'METHOD');
+ASSERT_EQ(w.M3(a := x, b := IncX(x), c := x), 50006, 'METHOD');
 x := 5;
-ASSERT_EQ(50006, i.M3(a := x, b := IncX(x), c := x), 'interface method');
+ASSERT_EQ(i.M3(a := x, b := IncX(x), c := x), 50006, 'interface method');
 x := 5;
 f(a := x, b := IncX(x), c := x);
-ASSERT_EQ(50006, f.q, 'FB instance');
+ASSERT_EQ(f.q, 50006, 'FB instance');
 END_TEST
 
 TEST 'a recursive METHOD keeps the arguments of every level'
 VAR w : Worker; END_VAR
-ASSERT_EQ(34, w.Rec(n := 0, k := 34));
-ASSERT_EQ(34, w.Rec(n := 1, k := 34));
-ASSERT_EQ(77, w.Rec(n := 9, k := 77));
+ASSERT_EQ(w.Rec(n := 0, k := 34), 34);
+ASSERT_EQ(w.Rec(n := 1, k := 34), 34);
+ASSERT_EQ(w.Rec(n := 9, k := 77), 77);
 END_TEST
 """)
 HEAD_FN = """(* test_nested_calls_fn.st: a call in an argument of a FUNCTION, an FB instance call or a
