@@ -564,7 +564,7 @@ std::unique_ptr<NativeCode> NativeCode::build(const Application& app, const Nati
   std::vector<uint32_t> entries, skipped;
   std::string source = native_source(app, &entries, &skipped);
   std::string compiler = !o.compiler.empty() ? o.compiler : (std::getenv("PLCFI_CXX") ? std::getenv("PLCFI_CXX") : "c++");
-  const std::vector<std::string> flags = {"-std=c++20", "-O2", "-fPIC", "-shared", "-w", "-fno-strict-aliasing", "-ffp-contract=off"};
+  const std::vector<std::string> flags = {"-std=c++20", o.optimize, "-fPIC", "-shared", "-w", "-fno-strict-aliasing", "-ffp-contract=off"};
   std::string key_text = source + compiler;
   for (const auto& f : flags) key_text += " " + f;
   key_text += embedded::kNativeAbiHpp;

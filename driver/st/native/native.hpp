@@ -19,6 +19,7 @@ namespace plcfi::st {
 struct NativeOptions {
   std::string cache_dir;   // "": $PLCFI_NATIVE_CACHE, $XDG_CACHE_HOME/plcfi/native, ~/.cache/plcfi/native
   std::string compiler;    // "": $PLCFI_CXX or c++
+  std::string optimize = "-O2";  // the compiler's optimization flag (tests that compile many programs: -O0)
 };
 
 // The C++ translation of every code entry reachable from the application's programs,

@@ -133,18 +133,22 @@ INSTANTIATE_TEST_SUITE_P(All, NativeTraps, ::testing::ValuesIn(kTraps),
 
 // Differential fuzzing: conformance tests with one integer literal changed (so asserts
 // fail, loops run longer, indexes leave their ranges...) give the same results, failure
-// messages and locations in both tiers.
-TEST(NativeTier, MutatedConformanceTestsGiveTheSameResults) {
+// messages and locations in both tiers. Four shards of six programs each (a shard is one
+// ctest with its own time-out; each program is a C++ compilation, at -O0 to keep a shard
+// well inside its time on a loaded machine).
+class NativeMutations : public ::testing::TestWithParam<int> {};
+
+TEST_P(NativeMutations, GiveTheSameResultsInBothTiers) {
   namespace fs = std::filesystem;
   fs::path dir = fs::path(PLCFI_SOURCE_DIR) / "tests" / "st";
   std::vector<fs::path> tests;
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().filename().string().rfind("test_", 0) == 0) tests.push_back(e.path());
   std::sort(tests.begin(), tests.end());
-  std::mt19937 rng(20261122);
+  std::mt19937 rng(20261122u + static_cast<unsigned>(GetParam()));
   const std::regex number(R"(\b[0-9]+\b)");
   int compared = 0, failing = 0;
-  for (int round = 0; round < 24; ++round) {
+  for (int round = 0; round < 6; ++round) {
     const fs::path& t = tests[rng() % tests.size()];
     std::string text = read_file(t.string());
     std::vector<std::pair<size_t, size_t>> spots;
@@ -164,7 +168,9 @@ TEST(NativeTier, MutatedConformanceTestsGiveTheSameResults) {
     if (!b->ok() || b->app->tests.empty()) continue;  // the change made it ill-typed
     SCOPED_TRACE(t.filename().string() + " with a literal at offset " + std::to_string(pos) + " changed");
     std::string err;
-    auto native = NativeCode::build(*b->app, NativeOptions{}, &err);
+    NativeOptions no;
+    no.optimize = "-O0";
+    auto native = NativeCode::build(*b->app, no, &err);
     ASSERT_TRUE(native) << err;
     Machine a(*b->app), n(*b->app);
     n.set_native(native.get());
@@ -183,9 +189,11 @@ TEST(NativeTier, MutatedConformanceTestsGiveTheSameResults) {
     ++compared;
   }
   std::printf("mutated programs compared: %d, failing tests among them: %d\n", compared, failing);
-  EXPECT_GE(compared, 8);
-  EXPECT_GE(failing, 3);  // the failure paths (asserts, traps) were exercised
+  EXPECT_GE(compared, 2);
+  EXPECT_GE(failing, 1);  // the failure paths (asserts, traps) were exercised
 }
+
+INSTANTIATE_TEST_SUITE_P(Shards, NativeMutations, ::testing::Range(0, 4));
 
 TEST(NativeTier, MissingCompilerIsAClearError) {
   auto b = build_sources({{"p.st", "PROGRAM P\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n"}}, CompileOptions{});
