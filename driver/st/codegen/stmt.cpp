@@ -172,6 +172,32 @@ void Compiler::stmt(const Stmt& s) {
 }
 
 void Compiler::assign_stmt(const AssignStmt& s) {
+  if (s.set_reset) {
+    // x S= c  ->  IF c THEN x := TRUE; END_IF   (R=: FALSE)
+    const char* op = s.set_reset == 'S' ? "S=" : "R=";
+    if (opt_.dialect == Dialect::Iec)
+      diags_.error("ST241", s.loc, std::string(op) + " is CODESYS, not IEC 61131-3: write IF c THEN x := " +
+                                       (s.set_reset == 'S' ? "TRUE" : "FALSE") + "; END_IF, or use --dialect codesys");
+    Place dst = place(*s.lhs, true);
+    uint32_t saved = b_->temp_top;
+    Val c = cond(*s.rhs);
+    if (!dst.ok || !c.ok) return;
+    if (dst.type->kind != TypeKind::Bool) {
+      diags_.error("ST203", s.lhs->loc, std::string(op) + " sets a BOOL, not " + dst.type->name);
+      return;
+    }
+    Label skip = new_label();
+    branch_on(c, s.rhs->loc, skip, false);
+    b_->temp_top = saved;
+    Val v;
+    v.type = elem(TypeKind::Bool);
+    v.is_const = true;
+    v.c.k = ConstV::K::Bool;
+    v.c.i = s.set_reset == 'S' ? 1 : 0;
+    assign(dst, v, s.loc);
+    bind(skip);
+    return;
+  }
   // Warn about x := x, a typing accident more often than intent.
   if (opt_.warnings && s.lhs->kind == ExprKind::Name && s.rhs->kind == ExprKind::Name &&
       iequals(static_cast<const NameExpr&>(*s.lhs).name.text, static_cast<const NameExpr&>(*s.rhs).name.text))

@@ -276,6 +276,7 @@ struct AssignStmt : Stmt {
   explicit AssignStmt(SourceLoc l) : Stmt(StmtKind::Assign, l) {}
   ExprPtr lhs, rhs;
   bool is_ref_assign = false;  // REF=
+  char set_reset = 0;          // 'S' for S= (CODESYS: lhs := TRUE when rhs), 'R' for R= (lhs := FALSE)
 };
 
 struct CallStmt : Stmt {

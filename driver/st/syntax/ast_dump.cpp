@@ -112,7 +112,7 @@ std::string dump(const Stmt& s) {
   switch (s.kind) {
     case StmtKind::Assign: {
       const auto& x = static_cast<const AssignStmt&>(s);
-      return std::string("(") + (x.is_ref_assign ? "REF=" : ":=") + " " + opt(x.lhs) + " " + opt(x.rhs) + ")";
+      return std::string("(") + (x.is_ref_assign ? "REF=" : x.set_reset == 'S' ? "S=" : x.set_reset == 'R' ? "R=" : ":=") + " " + opt(x.lhs) + " " + opt(x.rhs) + ")";
     }
     case StmtKind::Call: {
       const auto& x = static_cast<const CallStmt&>(s);

@@ -2,6 +2,8 @@
 // the checks for a missing ';' or block end.
 #include "parser_impl.hpp"
 
+#include <cctype>
+
 namespace plcfi::st::detail {
 
 // ================================================================ statements
@@ -91,12 +93,23 @@ StmtPtr Parser::parse_statement() {
   }
 }
 
-// assignment := postfix (':=' | 'REF=') expr ';'
+// assignment := postfix (':=' | 'REF=' | 'S=' | 'R=') expr ';'
 // call := postfix '(' call_args ')' ';'
 StmtPtr Parser::parse_assign_or_call() {
   const size_t start = pos_;
   const SourceLoc loc = cur().loc;
   ExprPtr target = parse_postfix();
+  // CODESYS set/reset assignment: `x S= c;` sets x when c holds, `x R= c;` resets it.
+  if (at(Tok::Ident) && (iequals(cur().text, "S") || iequals(cur().text, "R")) && la(1).kind == Tok::Eq &&
+      la(1).loc.line == cur().loc.line && la(1).loc.col == cur().loc.col + 1) {
+    auto s = std::make_unique<AssignStmt>(loc);
+    s->set_reset = static_cast<char>(std::toupper(static_cast<unsigned char>(advance().text[0])));
+    advance();  // '='
+    s->lhs = std::move(target);
+    s->rhs = parse_expr();
+    expect_semi("assignment");
+    return s;
+  }
   if (at(Tok::Assign) || at(Tok::RefAssign)) {
     auto s = std::make_unique<AssignStmt>(loc);
     s->is_ref_assign = advance().kind == Tok::RefAssign;
