@@ -14,7 +14,9 @@
 #include "json.hpp"
 #include "engine.hpp"
 #include "report/junit.hpp"
+#include "common/duration.hpp"
 #include "runtime/schedule.hpp"
+#include "runtime/tcunit.hpp"
 #include "test_runner.hpp"
 
 namespace po = boost::program_options;
@@ -251,75 +253,154 @@ int cmd_run(const std::vector<std::string>& args) {
   return status;
 }
 
+namespace {
+
+// One result line per test, grouped (a test file, a TcUnit suite), and its JUnit case.
+struct TestTally {
+  size_t passed = 0, failed = 0;
+  std::map<std::string, report::JunitSuite> suites;
+  std::vector<std::string> order;
+  std::string current;
+
+  void add(const std::string& group, const std::string& heading, const std::string& name, bool ok,
+           const std::string& where, const std::string& message, double seconds) {
+    if (group != current) {
+      current = group;
+      std::cout << "[" << heading << "]\n";
+    }
+    const std::string detail = where.empty() ? message : where + ": " + message;
+    if (ok) {
+      ++passed;
+      std::cout << "  PASS: " << name << "\n";
+    } else {
+      ++failed;
+      std::cout << "  FAIL: " << name << "\n    " << detail << "\n";
+    }
+    if (!suites.count(group)) order.push_back(group);
+    auto& s = suites[group];
+    s.name = group;
+    report::JunitCase c;
+    c.classname = group;
+    c.name = name;
+    c.seconds = seconds;
+    if (!ok) {
+      c.outcome = report::JunitCase::Outcome::Fail;
+      c.message = message;
+      c.detail = detail;
+    }
+    s.cases.push_back(c);
+  }
+};
+
+// The schedule a TcUnit run scans: the configuration's tasks, or one program.
+bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt::Schedule* sched) {
+  std::string err;
+  bool ok;
+  if (app.has_configuration && !vm.count("program")) {
+    ok = sched->from_configuration(app, &err);
+  } else {
+    int64_t cycle = 0;
+    if (!rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
+      std::cerr << "plcfi test: --cycle-time: " << err << "\n";
+      return false;
+    }
+    ok = sched->single_program(app, vm.count("program") ? vm["program"].as<std::string>() : "", cycle, &err);
+  }
+  if (!ok) std::cerr << "plcfi test: TcUnit suites run in the scan of the program that calls TcUnit.RUN(): " << err << "\n";
+  return ok;
+}
+
+}  // namespace
+
 int cmd_test(const std::vector<std::string>& args) {
-  po::options_description desc("plcfi test: run ST unit-test files (sources and test files in any order)");
+  po::options_description desc(
+      "plcfi test: run ST unit tests: test files (sources and test files in any order) and TcUnit suites "
+      "(function blocks that EXTEND FB_TestSuite, run by TcUnit.RUN())");
   desc.add_options()
       ("junit", po::value<std::string>(), "write JUnit XML to this file")
       ("coverage", "print branch coverage of the sources")
       ("budget", po::value<Count>()->default_value(Count{100'000'000}, "100000000"), "loop iterations allowed per test phase (watchdog)")
-      ("native", "run the tests through the native tier (generated C++, compiled by the system's compiler)");
+      ("native", "run the tests through the native tier (generated C++, compiled by the system's compiler)")
+      ("timeout", po::value<std::string>()->default_value("10s"), "TcUnit: virtual time the suites get to finish every test (TcUnit's default: 10s)")
+      ("program", po::value<std::string>(), "TcUnit: the program to scan (the one calling TcUnit.RUN()) when there is no task configuration or to run it alone")
+      ("cycle-time", po::value<std::string>()->default_value("10ms"), "TcUnit: cycle time of that program");
   po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--timeout 10s]")) return 0;
+  int64_t timeout_ns = 0;
+  std::string err;
+  if (!rt::parse_duration(vm["timeout"].as<std::string>(), &timeout_ns, &err) || timeout_ns <= 0) {
+    std::cerr << "plcfi test: --timeout: " << (err.empty() ? "must be positive" : err) << "\n";
+    return 2;
+  }
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
   opt.test_mode = true;
   opt.warnings = false;
   auto b = load(strings_of(vm, "files"), opt, "test");
   if (!b || !b->ok()) return 2;
-  if (b->tests.empty()) {
-    std::cerr << "plcfi test: no test file among the inputs (a test file starts with TEST, SETUP or TEARDOWN)\n";
+  const st::Application& app = *b->app;
+  const bool tcunit = rt::has_tcunit_suites(app);
+  if (b->tests.empty() && !tcunit) {
+    std::cerr << "plcfi test: no tests among the inputs: neither a test file (it starts with TEST, SETUP or TEARDOWN) "
+                 "nor a TcUnit suite instance (of a function block that EXTENDS FB_TestSuite)\n";
     return 2;
   }
-  st::Machine m(*b->app);
+  rt::Schedule sched;
+  if (tcunit && !tcunit_schedule(app, vm, &sched)) return 2;
+  st::Machine m(app);
   std::unique_ptr<st::NativeCode> native;
-  if (vm.count("native") && !(native = load_native(*b->app, "plcfi test"))) return 2;
+  if (vm.count("native") && !(native = load_native(app, "plcfi test"))) return 2;
   m.set_native(native.get());
-  st::TestRunOptions ro;
-  ro.budget = vm["budget"].as<Count>().value;
-  auto results = st::run_tests(*b->app, m, ro);
-  size_t passed = 0, failed = 0;
-  std::string current;
-  std::map<std::string, report::JunitSuite> suites;
-  std::vector<std::string> order;
-  for (const auto& r : results) {
-    if (r.file != current) {
-      current = r.file;
-      std::cout << "[" << r.file << "]\n";
-    }
-    if (r.passed) {
-      ++passed;
-      std::cout << "  PASS: " << r.name << "\n";
-    } else {
-      ++failed;
-      std::cout << "  FAIL: " << r.name << "\n    " << r.where << ": " << r.message << "\n";
-    }
-    if (!suites.count(r.file)) order.push_back(r.file);
-    auto& s = suites[r.file];
-    s.name = r.file;
-    report::JunitCase c;
-    c.classname = r.file;
-    c.name = r.name;
-    c.seconds = r.seconds;
-    if (!r.passed) {
-      c.outcome = report::JunitCase::Outcome::Fail;
-      c.message = r.message;
-      c.detail = r.where + ": " + r.message;
-    }
-    s.cases.push_back(c);
+  TestTally tally;
+  if (!b->tests.empty()) {
+    st::TestRunOptions ro;
+    ro.budget = vm["budget"].as<Count>().value;
+    for (const auto& r : st::run_tests(app, m, ro)) tally.add(r.file, r.file, r.name, r.passed, r.where, r.message, r.seconds);
   }
-  if (vm.count("coverage")) std::cout << st::coverage_report(*b->app, m.covered());
-  std::cout << passed << " passed, " << failed << " failed\n";
+  if (tcunit) {
+    rt::TcUnitOptions to;
+    to.timeout_ns = timeout_ns;
+    to.budget = vm["budget"].as<Count>().value;
+    auto start = std::chrono::steady_clock::now();
+    rt::TcUnitReport rep = rt::run_tcunit(app, sched, m, to);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!rep.program_trap.empty()) std::cerr << rep.program_trap << "\n";
+    if (!rep.run_called) {
+      std::cerr << "plcfi test: TcUnit.RUN() was not called within " << common::format_duration(to.timeout_ns)
+                << ": call it in the program that holds the suites (e.g. PRG_TEST, called by a task)\n";
+      return 1;
+    }
+    size_t tests = 0, failed = 0;
+    for (const auto& s : rep.suites) {
+      const std::string heading = s.path + " (" + s.type->name + ", " + app.where(b->sm.origin(s.type->loc)) + ")";
+      for (const auto& t : s.tests) {
+        ++tests;
+        failed += t.failed;
+        const std::string where = t.where.valid() ? app.where(b->sm.origin(t.where)) : "";
+        tally.add(s.path, heading, t.name, !t.failed, where, t.message, seconds / static_cast<double>(s.tests.size()));
+      }
+      if (s.tests.empty())
+        std::cout << "[" << heading << "]\n  "
+                  << (s.started ? "(no tests)" : "(not started: RUN_IN_SEQUENCE starts a suite when the one before it is done)")
+                  << "\n";
+      if (s.overflow) std::cout << "  (more than 100 tests in this suite: the rest were not run)\n";
+    }
+    std::cout << fmt::format("TcUnit: {} test suites, {} tests, {} successful, {} failed ({} of virtual time, {} cycles{})\n",
+                             rep.suites.size(), tests, tests - failed, failed, common::format_duration(rep.virtual_ns),
+                             rep.cycles, rep.timed_out ? "; the time-out ended the run" : "");
+  }
+  if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
+  std::cout << tally.passed << " passed, " << tally.failed << " failed\n";
   if (vm.count("junit")) {
     std::vector<report::JunitSuite> v;
-    for (const auto& f : order) v.push_back(suites[f]);
-    std::string err;
+    for (const auto& f : tally.order) v.push_back(tally.suites[f]);
     if (!report::write_junit(vm["junit"].as<std::string>(), v, &err)) {
       std::cerr << "plcfi test: " << err << "\n";
       return 2;
     }
   }
-  return failed ? 1 : 0;
+  return tally.failed ? 1 : 0;
 }
 
 }  // namespace plcfi::cli

@@ -4,6 +4,7 @@
 #include "vm/memory.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -31,8 +32,21 @@ void map_imported(Application& app, const SourceManager& sm, const std::set<uint
   for (auto& task : app.tasks) map(task.loc);
 }
 
-std::unique_ptr<Build> finish(std::unique_ptr<Build> b, const std::vector<uint32_t>& files, const CompileOptions& opt,
+// TcUnit comes with the application when a source names its FB_TestSuite.
+bool uses_tcunit(const SourceManager& sm, const std::vector<uint32_t>& files) {
+  static const std::string key = "fb_testsuite";
+  for (uint32_t f : files) {
+    const std::string& text = sm.file(f).text;
+    auto it = std::search(text.begin(), text.end(), key.begin(), key.end(),
+                          [](char a, char k) { return std::tolower(static_cast<unsigned char>(a)) == k; });
+    if (it != text.end() && !is_library_path(sm.file(f).path)) return true;
+  }
+  return false;
+}
+
+std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> files, const CompileOptions& opt,
                               const GeneratedSources& late, const std::set<uint32_t>& imported = {}) {
+  if (uses_tcunit(b->sm, files)) files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
   for (uint32_t f : files) {
     if (is_test_file(b->sm, f)) b->tests.push_back(parse_test_file(b->sm, f, b->diags));
     else b->units.push_back(parse_unit(b->sm, f, b->diags));
@@ -593,7 +607,7 @@ std::string coverage_report(const Application& app, const std::vector<uint64_t>&
   std::map<std::string, FileCov> files;
   for (size_t i = 0; i < app.branches.size(); ++i) {
     const auto& b = app.branches[i];
-    if (b.loc.file >= app.file_paths.size() || app.file_paths[b.loc.file] == "<stdlib>") continue;
+    if (b.loc.file >= app.file_paths.size() || is_library_path(app.file_paths[b.loc.file])) continue;
     auto& fc = files[app.file_paths[b.loc.file]];
     ++fc.total;
     bool hit = i / 64 < covered.size() && ((covered[i / 64] >> (i % 64)) & 1u);

@@ -97,6 +97,13 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
                                                                             std::string("interface")));
       return bad();
     }
+    if (key == "__NEW" || key == "__DELETE" || key == "__QUERYINTERFACE" || key == "__QUERYPOINTER") {
+      diags_.error("ST235", callee.loc,
+                   n.name.text + (key == "__NEW" || key == "__DELETE"
+                                      ? " (dynamic memory) is CODESYS that plcfi does not run: declare the instance as a variable"
+                                      : " is CODESYS that plcfi does not run yet: call the methods through a variable of the interface"));
+      return bad();
+    }
     if (auto b = builtin(key, c)) return *b;
     // A method of this instance called by its bare name.
     if (b_->this_type && b_->this_type->pou) {
@@ -112,6 +119,16 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
     const auto& m = static_cast<const MemberExpr&>(callee);
     bool via_super = m.base->kind == ExprKind::Deref && static_cast<const DerefExpr&>(*m.base).base->kind == ExprKind::Super;
     bool via_this = m.base->kind == ExprKind::Deref && static_cast<const DerefExpr&>(*m.base).base->kind == ExprKind::This;
+    // Lib.F(): a FUNCTION of a library namespace (TcUnit.RUN()), when Lib names nothing else.
+    if (m.base->kind == ExprKind::Name) {
+      const std::string ns = canon(static_cast<const NameExpr&>(*m.base).name.text);
+      if (!lookup(ns) && !pous_.count(ns) && !types_.count(ns)) {
+        const std::string key = canon(m.member.text);
+        if (auto it = pous_.find(key); it != pous_.end() && it->second->kind == PouKind::Function)
+          return call_function(it->second, c);
+        if (auto b = builtin(key, c)) return *b;
+      }
+    }
     Place base = place(*m.base, false);
     if (!base.ok) return bad();
     if (base.type->kind == TypeKind::Interface) {
@@ -430,6 +447,7 @@ void Compiler::declare_pou(PouInfo* p) {
 // from the frame right after the call, before any destination is evaluated, for the same
 // reason.
 Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt) {
+  if (is_tcunit_method(m) && !(m = tcunit_lowering(c, m))) return bad();
   declare_pou(m);
   (void)inst;
   std::vector<Symbol*> params = m->inputs;
@@ -527,6 +545,8 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
       if (!staged[i].ok) continue;
       if (staged[i].direct) assign(field, staged[i].v, bound[i]->loc);
       else store(field, staged[i].v.slot);
+    } else if (is_tcunit_method(m) && iequals(p->name, "_tcuAt")) {
+      store(field, konst_i64(pack_location(c.loc)));  // where the assertion is, for its failure
     } else {
       store(field, konst_bytes(p->init.data(), static_cast<uint32_t>(p->init.size()), p->type->align));
     }

@@ -755,7 +755,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   start_program();
   std::vector<const CompilationUnit*> all = units;
   for (const auto* t : tests) all.push_back(&t->decls);
-  for (const auto* u : all) index_unit(*u, u->file < sm_.size() && sm_.file(u->file).path == "<stdlib>");
+  for (const auto* u : all) index_unit(*u, u->file < sm_.size() && is_library_path(sm_.file(u->file).path));
   declare_units(all, 0);
 
   // Every POU is compiled (and so checked), used or not.
@@ -764,7 +764,9 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   check_interfaces(0);
 
   configure(units);
-  if (!app_->has_configuration && !opt_.test_mode) {
+  // Without a configuration every PROGRAM gets an instance (also in test builds, where a
+  // TcUnit run scans the program that calls TcUnit.RUN()).
+  if (!app_->has_configuration) {
     for (const auto& p : app_->pous)
       if (p->kind == PouKind::Program && !p->is_stdlib) app_->programs.push_back(ProgramInstance{p->name, p.get(), 0, ""});
   }

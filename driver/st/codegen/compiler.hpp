@@ -47,5 +47,13 @@ bool link_units(Application& app, const SourceManager& sm, const std::vector<con
 
 // The standard library's ST source (standard FBs), compiled with every application.
 const char* stdlib_source();
+// The TcUnit framework's ST source (FB_TestSuite, RUN), compiled with an application whose
+// sources use it (stdlib/tcunit.cpp).
+const char* tcunit_source();
+// The location a TcUnit assertion's hidden input _tcuAt holds (codegen/tcunit.cpp).
+SourceLoc unpack_location(int64_t packed);
+// The libraries plcfi brings, loaded under these names: no warnings, mocks, coverage or
+// listing of their own. (Other sources in memory have names in angle brackets too.)
+inline bool is_library_path(const std::string& path) { return path == "<stdlib>" || path == "<TcUnit>"; }
 
 }  // namespace plcfi::st

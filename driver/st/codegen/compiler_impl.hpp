@@ -312,6 +312,18 @@ class Compiler {
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
   void store_outputs(const std::vector<std::pair<Symbol*, const CallArg*>>& outs, const std::vector<Val>& out_vals);
+  // ---- TcUnit (tcunit.cpp, with stdlib/tcunit.cpp)
+  // A method of the library's FB_TestSuite.
+  static bool is_tcunit_method(const PouInfo* m);
+  // The call's location as the LINT the library's hidden input _tcuAt takes.
+  static int64_t pack_location(SourceLoc loc);
+  // AssertEquals (ANY) becomes AssertEquals_<type of Actual>; AssertArray*Equals_<T>
+  // compares the arrays (native ARRAY_DIFF). The arguments are evaluated here and their
+  // values left in preset_. Other methods come back unchanged; nullptr after an error.
+  PouInfo* tcunit_lowering(const CallExpr& c, PouInfo* m);
+  // Values already computed for these expressions: expr() takes them (once) instead of
+  // compiling the expression again.
+  std::unordered_map<const Expr*, Val> preset_;
   Val property_get(const Place& inst, PouInfo* getter, Slot this_ptr, SourceLoc loc);
   void property_set(PouInfo* setter, Slot this_ptr, const Val& v, SourceLoc loc);
   const Type* call_expected_ = nullptr;  // the type the context expects of the call being compiled

@@ -320,6 +320,13 @@ Val Compiler::expr_for(const Expr& e, const Type* target) {
 }
 
 Val Compiler::expr(const Expr& e, const Type* expected) {
+  if (!preset_.empty()) {
+    if (auto it = preset_.find(&e); it != preset_.end()) {
+      Val v = it->second;
+      preset_.erase(it);
+      return v;
+    }
+  }
   Val r = [&]() -> Val {
     switch (e.kind) {
       case ExprKind::Literal: return literal(static_cast<const LiteralExpr&>(e), expected);

@@ -237,6 +237,7 @@ TypeSpecPtr Parser::parse_type_spec() {
   advance();
   spec->kind = TypeSpecKind::Named;
   spec->name = Ident{std::string(t.text), t.loc};
+  skip_namespace(&spec->name);
   const bool is_string = iequals(t.text, "STRING") || iequals(t.text, "WSTRING");
   if (is_string && (at(Tok::LBracket) || at(Tok::LParen))) {
     const Tok close = at(Tok::LBracket) ? Tok::RBracket : Tok::RParen;
@@ -443,12 +444,16 @@ PouPtr Parser::parse_pou() {
   if (pou->kind == PouKind::FunctionBlock) {
     if (accept(Tok::Extends)) {
       Ident base;
-      if (expect_ident(&base, "ST100", "a base FUNCTION_BLOCK name after EXTENDS")) pou->extends = base;
+      if (expect_ident(&base, "ST100", "a base FUNCTION_BLOCK name after EXTENDS")) {
+        skip_namespace(&base);
+        pou->extends = base;
+      }
     }
     if (accept(Tok::Implements)) {
       do {
         Ident i;
         if (!expect_ident(&i, "ST100", "an interface name after IMPLEMENTS")) break;
+        skip_namespace(&i);
         pou->implements.push_back(std::move(i));
       } while (accept(Tok::Comma));
     }
@@ -456,6 +461,7 @@ PouPtr Parser::parse_pou() {
     do {
       Ident i;
       if (!expect_ident(&i, "ST100", "an interface name after EXTENDS")) break;
+      skip_namespace(&i);
       pou->implements.push_back(std::move(i));
     } while (accept(Tok::Comma));
   }

@@ -68,6 +68,14 @@ void Parser::skip_nested() {
 
 // ================================================================ names
 
+void Parser::skip_namespace(Ident* id) {
+  while (at(Tok::Dot) && la(1).kind == Tok::Ident) {
+    advance();
+    const Token& t = advance();
+    *id = Ident{std::string(t.text), t.loc};
+  }
+}
+
 bool Parser::expect_ident(Ident* out, const char* code, const std::string& what) {
   if (at(Tok::Ident)) {
     const Token& t = advance();

@@ -250,6 +250,9 @@ class Parser {
     skip_nested();
     return error_expr(loc);
   }
+  // After a name: `.Name` parts of a library namespace (TcUnit.FB_TestSuite, as CODESYS
+  // and TwinCAT write a POU or type of a library): *id becomes the last part.
+  void skip_namespace(Ident* id);
   bool expect_ident(Ident* out, const char* code, const std::string& what);
 
   // ------------------------------------------------------------ expressions (parse_exprs.cpp)

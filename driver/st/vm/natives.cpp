@@ -233,6 +233,7 @@ constexpr Entry kNatives[] = {
     {s_to_bool, "STRING_TO_BOOL"}, {s_to_time, "STRING_TO_TIME"},
     {dt_to_date, "DT_TO_DATE"}, {dt_to_tod, "DT_TO_TOD"},
     {bcd_decode, "BCD_DECODE"}, {bcd_encode, "BCD_ENCODE"},
+    {array_difference, "ARRAY_DIFF"},
 };
 static_assert(sizeof(kNatives) / sizeof(kNatives[0]) == static_cast<size_t>(Native::Count_));
 

@@ -18,6 +18,7 @@ enum class Native : uint32_t {
   S_TO_I64, S_TO_U64, S_TO_F64, S_TO_BOOL, S_TO_TIME,
   DT_TO_DATE, DT_TO_TOD,
   BCD_DECODE, BCD_ENCODE,  // a := f(b), both ULINT
+  ARRAY_DIFF,              // a := the first difference of two arrays (vm.cpp: array_difference)
   Count_
 };
 

@@ -647,6 +647,46 @@ int compare(ValueKind k, const uint8_t* a, const uint8_t* b) {
 }
 }  // namespace
 
+void array_difference(Machine& m, uint32_t cap, uint8_t* out, uint8_t* blk, uint8_t* shape_bytes, uint8_t*) {
+  ArrayDiffShape s;
+  std::memcpy(&s, shape_bytes, sizeof s);
+  const uint32_t addr_e = ld<uint32_t>(blk), addr_a = ld<uint32_t>(blk + 4);
+  const double delta = ld<double>(blk + 8);
+  const auto kind = static_cast<ValueKind>(s.kind);
+  std::string msg;
+  auto fits = [&](uint32_t addr, uint32_t count, uint32_t size) {
+    return addr != 0 && static_cast<uint64_t>(addr) + static_cast<uint64_t>(count) * size <= m.mem_size();
+  };
+  if (s.count_e != s.count_a) {
+    msg = fmt::format("EXP: an array of {} elements, ACT: {} elements", s.count_e, s.count_a);
+  } else if (!fits(addr_e, s.count_e, s.elem_size) || !fits(addr_a, s.count_a, s.elem_size_a)) {
+    msg = "an array outside the memory";  // the compiler passes whole arrays: not reached
+  } else {
+    for (uint32_t i = 0; i < s.count_e; ++i) {
+      const uint8_t* x = m.mem() + addr_e + static_cast<size_t>(i) * s.elem_size;
+      const uint8_t* y = m.mem() + addr_a + static_cast<size_t>(i) * s.elem_size_a;
+      bool same;
+      if (kind == ValueKind::F32) same = std::fabs(static_cast<double>(ld<float>(x)) - ld<float>(y)) <= delta;
+      else if (kind == ValueKind::F64) same = std::fabs(ld<double>(x) - ld<double>(y)) <= delta;
+      else same = compare(kind, x, y) == 0;
+      if (same) continue;
+      // The element's index in the expected array, one number per dimension (row-major).
+      std::string index;
+      uint32_t rest = i;
+      for (uint32_t k = s.ndims; k-- > 0;) {
+        const uint32_t ext = s.extent[k] ? s.extent[k] : 1;
+        index = fmt::format("{}{}", static_cast<int64_t>(s.lo[k]) + rest % ext, index.empty() ? "" : "," + index);
+        rest /= ext;
+      }
+      msg = fmt::format("EXP: {}, ACT: {} at [{}]", format_value(kind, x), format_value(kind, y), index);
+      break;
+    }
+  }
+  const size_t n = std::min<size_t>(msg.size(), cap);
+  std::memcpy(out, msg.data(), n);
+  out[n] = 0;
+}
+
 bool Machine::do_assert(const uint32_t* pc, uint8_t* base) {
   auto kind = static_cast<AssertKind>(pc[1] >> 8);
   auto vk = static_cast<ValueKind>(pc[1] & 0xffu);

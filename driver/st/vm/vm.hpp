@@ -37,6 +37,19 @@ class NativeCode;
 // Natives implement the standard functions the compiler does not open-code
 // (string functions, transcendental math, conversions to and from text).
 using NativeFn = void (*)(Machine& m, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d);
+// Native ARRAY_DIFF (TcUnit's AssertArrayEquals_<T>): a := '' when the arrays are equal,
+// else the first difference (sizes, or an element) as TcUnit words it. b: the run-time
+// block {UDINT address of the expected array, UDINT of the actual one, LREAL delta};
+// c: the constant ArrayDiffShape.
+struct ArrayDiffShape {
+  uint32_t count_e, count_a;  // elements
+  uint32_t elem_size, elem_size_a;  // bytes per element, expected and actual
+  uint32_t kind;              // ValueKind of an element
+  uint32_t ndims;             // 1..3: the expected array's dimensions, to name an element
+  int32_t lo[3];
+  uint32_t extent[3];
+};
+void array_difference(Machine& m, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d);
 NativeFn native(uint32_t id);
 const char* native_name(uint32_t id);
 

@@ -1,14 +1,13 @@
 #!/usr/bin/env bash
-# One CLI case of the PLCopen XML importer: `plcfi ARGS...` run in this folder (so the
-# paths in messages are stable), its complete output and exit status must equal
-# expected/NAME.txt line for line.
-#   usage: cli_snapshot.sh PLCFI NAME ARGS...
+# One CLI case: `plcfi ARGS...` run in folder DIR (so the paths in messages are stable),
+# its complete output and exit status must equal DIR/expected/NAME.txt line for line.
+#   usage: cli_snapshot.sh PLCFI DIR NAME ARGS...
 #   PLCFI_UPDATE_SNAPSHOTS=1 rewrites expected/NAME.txt (review the diff before committing).
 set -u
 plcfi=$1
-name=$2
-shift 2
-dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+dir=$(cd "$2" && pwd)
+name=$3
+shift 3
 expected=$dir/expected/$name.txt
 # Wall-clock figures are the only thing that changes from run to run.
 actual=$(cd "$dir" && "$plcfi" "$@" 2>&1 | sed -E 's/[0-9]+(\.[0-9]+)? ?(ms|s) wall/<time> wall/g'; echo "exit=${PIPESTATUS[0]}")
