@@ -71,6 +71,7 @@ PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
   const bool generic = iequals(m->name, "AssertEquals");
   const bool array = starts_with_ci(m->name, "AssertArray");
   if (!generic && !array) return m;
+  declare_pou(m);  // its inputs, for arguments by position
   // The argument bound to input `name` (by name, or by position among the inputs).
   auto arg = [&](std::string_view name) -> const CallArg* {
     size_t pos = 0;
