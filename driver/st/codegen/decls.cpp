@@ -255,6 +255,23 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
         if (it != types_.end() && !it->second.type) it->second.type = t;
       }
       laying_out_.push_back(t);
+      if (spec.struct_base) {
+        // STRUCT EXTENDS (CODESYS): the base's members first, at their offsets.
+        if (opt_.dialect == Dialect::Iec)
+          diags_.error("ST241", spec.struct_base->loc, "STRUCT EXTENDS is CODESYS, not IEC 61131-3: declare the base as "
+                                                       "a member, or use --dialect codesys");
+        const Type* base = named_type(*spec.struct_base, file);
+        if (base && (base->kind != TypeKind::Struct || base->is_union)) {
+          diags_.error("ST226", spec.struct_base->loc, "'" + spec.struct_base->text + "' is not a STRUCT");
+        } else if (base && std::find(laying_out_.begin(), laying_out_.end(), base) != laying_out_.end()) {
+          diags_.error("ST226", spec.struct_base->loc, "STRUCT '" + t->name + "' extends itself");
+        } else if (base) {
+          t->fields = base->fields;
+          t->size = base->size;
+          t->align = base->align;
+          t->init = base->init;
+        }
+      }
       layout_struct(t, spec.members, file);
       laying_out_.pop_back();
       result = t;
@@ -344,7 +361,9 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
 }
 
 void Compiler::layout_struct(Type* t, const std::vector<VarDecl>& members, uint32_t file) {
-  uint32_t off = 0, align = 1;
+  // A STRUCT that EXTENDS another holds the base's fields, size and image already.
+  uint32_t off = t->fields.empty() ? 0 : t->size, align = t->fields.empty() ? 1 : t->align;
+  const std::vector<uint8_t> base_init = t->init;
   struct Pending {
     uint32_t offset;
     const Type* type;
@@ -397,6 +416,7 @@ void Compiler::layout_struct(Type* t, const std::vector<VarDecl>& members, uint3
   t->align = std::min<uint32_t>(align, 8);
   t->size = align_up(off, t->align);
   t->init.assign(t->size, 0);
+  std::copy(base_init.begin(), base_init.begin() + std::min(base_init.size(), t->init.size()), t->init.begin());
   for (const auto& p : inits) write_init(t->init, p.offset, p.type, p.init, file);
 }
 

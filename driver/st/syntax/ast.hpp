@@ -218,6 +218,7 @@ struct TypeSpec {
   ExprPtr sub_lo, sub_hi;
   bool is_pointer = false;  // Ref spelt POINTER TO
   bool is_union = false;      // Struct spelt UNION ... END_UNION (CODESYS): every member at offset 0
+  std::optional<Ident> struct_base;  // TYPE T EXTENDS B : STRUCT (CODESYS): B's members first
   bool is_reference = false;  // Ref spelt REFERENCE TO (CODESYS): dereferenced implicitly on every use
 };
 using TypeSpecPtr = std::unique_ptr<TypeSpec>;

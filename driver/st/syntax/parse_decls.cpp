@@ -310,12 +310,26 @@ void Parser::parse_type_block(std::vector<TypeDecl>& out) {
       const Token& name = advance();
       td.name = Ident{std::string(name.text), name.loc};
       td.loc = name.loc;
+      std::optional<Ident> base;
+      if (accept(Tok::Extends)) {  // CODESYS: TYPE T EXTENDS B : STRUCT ... END_STRUCT
+        Ident b;
+        if (expect_ident(&b, "ST100", "a base STRUCT name after EXTENDS")) {
+          skip_namespace(&b);
+          base = b;
+        }
+      }
       if (!accept(Tok::Colon)) {
         error("ST134", missing_loc(), "expected ':' and a type after '" + td.name.text + "', found " + describe(cur()));
         sync_decl();
         continue;
       }
       td.spec = parse_type_spec();
+      if (base) {
+        if (td.spec->kind == TypeSpecKind::Struct && !td.spec->is_union)
+          td.spec->struct_base = base;
+        else
+          error("ST119", base->loc, "only a STRUCT can EXTEND another ('" + td.name.text + "' is not a STRUCT)");
+      }
       if (accept(Tok::Assign)) td.init = parse_initializer();
       const bool struct_like = td.spec->kind == TypeSpecKind::Struct;
       if (!accept(Tok::Semi) && !struct_like) {
