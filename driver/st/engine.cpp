@@ -32,16 +32,32 @@ void map_imported(Application& app, const SourceManager& sm, const std::set<uint
   for (auto& task : app.tasks) map(task.loc);
 }
 
-// TcUnit comes with the application when a source names its FB_TestSuite.
+// TcUnit comes with the application when a source names its FB_TestSuite, unless a
+// source declares an FB_TestSuite of its own (a copy of TcUnit's sources in the project).
 bool uses_tcunit(const SourceManager& sm, const std::vector<uint32_t>& files) {
   static const std::string key = "fb_testsuite";
+  bool named = false;
   for (uint32_t f : files) {
+    if (is_library_path(sm.file(f).path)) continue;
     const std::string& text = sm.file(f).text;
-    auto it = std::search(text.begin(), text.end(), key.begin(), key.end(),
-                          [](char a, char k) { return std::tolower(static_cast<unsigned char>(a)) == k; });
-    if (it != text.end() && !is_library_path(sm.file(f).path)) return true;
+    for (auto it = text.begin();; ++it) {
+      it = std::search(it, text.end(), key.begin(), key.end(),
+                       [](char a, char k) { return std::tolower(static_cast<unsigned char>(a)) == k; });
+      if (it == text.end()) break;
+      named = true;
+      // Declared here: FUNCTION_BLOCK [modifiers] FB_TestSuite, i.e. the word before it
+      // (past blanks) is FUNCTION_BLOCK or a modifier that only follows it.
+      auto word_end = it;
+      while (word_end != text.begin() && std::isspace(static_cast<unsigned char>(word_end[-1]))) --word_end;
+      auto word_begin = word_end;
+      while (word_begin != text.begin() && (std::isalnum(static_cast<unsigned char>(word_begin[-1])) || word_begin[-1] == '_')) --word_begin;
+      const std::string before(word_begin, word_end);
+      if (iequals(before, "FUNCTION_BLOCK") || iequals(before, "ABSTRACT") || iequals(before, "PUBLIC") ||
+          iequals(before, "FINAL") || iequals(before, "INTERNAL"))
+        return false;
+    }
   }
-  return false;
+  return named;
 }
 
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> files, const CompileOptions& opt,
