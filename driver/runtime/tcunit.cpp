@@ -153,6 +153,7 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
       break;
     }
     m.set_now(now);
+    m.clear_taken();
     schedule.for_each_due(n, [&](const ScheduledTask& t) {
       for (size_t pi : t.programs) {
         if (!rep.program_trap.empty()) return;
@@ -162,9 +163,15 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
       }
     });
     ++n;
-    if (!rep.program_trap.empty()) break;
+    if (!rep.program_trap.empty()) {
+      m.merge_coverage();
+      break;
+    }
     uint8_t* mem = m.mem();
-    if (st::load_as<int32_t>(mem + run->offset) == 0) continue;  // RUN() not called in this scan
+    if (st::load_as<int32_t>(mem + run->offset) == 0) {  // RUN() not called in this scan
+      m.merge_coverage();
+      continue;
+    }
     rep.run_called = true;
     st::store_as<int32_t>(mem + run->offset, 0);
     const bool in_sequence = st::load_as<int16_t>(mem + mode->offset) == 2;
@@ -184,6 +191,7 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
       }
       if (in_sequence && !s.done) break;  // the next suite starts when this one is done
     }
+    m.merge_coverage();  // branch coverage of the program and the suites (--coverage)
   }
   rep.cycles = n;
   rep.virtual_ns = static_cast<int64_t>(n) * tick;
