@@ -220,6 +220,10 @@ struct TypeSpec {
   bool is_union = false;      // Struct spelt UNION ... END_UNION (CODESYS): every member at offset 0
   std::optional<Ident> struct_base;  // TYPE T EXTENDS B : STRUCT (CODESYS): B's members first
   bool is_reference = false;  // Ref spelt REFERENCE TO (CODESYS): dereferenced implicitly on every use
+  // Named: `fb : FB_X(a := 1)` in a VAR block (CODESYS): the arguments of the instance's
+  // FB_init, called at every restart.
+  bool has_init_args = false;
+  std::vector<CallArg> init_args;
 };
 using TypeSpecPtr = std::unique_ptr<TypeSpec>;
 

@@ -9,6 +9,19 @@ namespace {
 
 std::string opt(const ExprPtr& e) { return e ? dump(*e) : std::string("_"); }
 
+// " a (b := c) (NOT q => d)": the arguments of a call or of a declaration's FB_init.
+std::string dump_args(const std::vector<CallArg>& args) {
+  std::string s;
+  for (const auto& a : args) {
+    if (!a.name) {
+      s += " " + opt(a.value);
+      continue;
+    }
+    s += std::string(" (") + (a.negate ? "NOT " : "") + a.name->text + (a.is_output ? " => " : " := ") + opt(a.value) + ")";
+  }
+  return s;
+}
+
 std::string literal(const LiteralExpr& l) {
   std::ostringstream out;
   if (!l.type_prefix.empty()) out << l.type_prefix << '#';
@@ -54,16 +67,7 @@ std::string dump(const Expr& e) {
     case ExprKind::Deref: return "(^ " + opt(static_cast<const DerefExpr&>(e).base) + ")";
     case ExprKind::Call: {
       const auto& x = static_cast<const CallExpr&>(e);
-      std::string s = "(call " + opt(x.callee);
-      for (const auto& a : x.args) {
-        if (!a.name) {
-          s += " " + opt(a.value);
-          continue;
-        }
-        s += std::string(" (") + (a.negate ? "NOT " : "") + a.name->text + (a.is_output ? " => " : " := ") +
-             opt(a.value) + ")";
-      }
-      return s + ")";
+      return "(call " + opt(x.callee) + dump_args(x.args) + ")";
     }
     case ExprKind::Unary: {
       const auto& x = static_cast<const UnaryExpr&>(e);
@@ -169,6 +173,7 @@ std::string dump(const Stmt& s) {
 std::string dump(const TypeSpec& t) {
   switch (t.kind) {
     case TypeSpecKind::Named:
+      if (t.has_init_args) return "(FB_init " + t.name.text + dump_args(t.init_args) + ")";
       return t.name.text + (t.string_length ? "[" + dump(*t.string_length) + "]" : std::string());
     case TypeSpecKind::Array: {
       std::string s = "ARRAY[";

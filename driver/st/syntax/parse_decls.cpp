@@ -144,7 +144,7 @@ bool Parser::parse_var_decl(std::vector<VarDecl>& out, VarSection section, bool 
 //            | REF_TO type_spec | POINTER TO type_spec | REFERENCE TO type_spec
 //            | '(' enum_value {',' enum_value} ')' [name]
 //            | (STRING | WSTRING) ['[' expr ']' | '(' expr ')']
-//            | name ['(' enum_value {',' enum_value} ')' | '(' expr '..' expr ')']
+//            | name ['(' enum_value {',' enum_value} ')' | '(' expr '..' expr ')' | call_args]
 // range := expr '..' expr
 TypeSpecPtr Parser::parse_type_spec() {
   DepthGuard guard(*this);
@@ -246,6 +246,13 @@ TypeSpecPtr Parser::parse_type_spec() {
     expect(close, "ST116", "to close the string length");
     return spec;
   }
+  if (at(Tok::LParen) && !is_integer_type_name(t.text) && !subrange_follows()) {
+    // `fb : FB_X(a := 1, 'name')`: FB_init arguments (CODESYS). Typed enumerations and
+    // subranges are based on an elementary integer type, so only those take '(' otherwise.
+    spec->has_init_args = true;
+    parse_call_args(spec->init_args, spec->name.text);
+    return spec;
+  }
   if (at(Tok::LParen)) {
     const Tok k1 = la(1).kind, k2 = la(2).kind;
     if (k1 == Tok::Ident && (k2 == Tok::Assign || k2 == Tok::Comma || k2 == Tok::RParen)) {
@@ -271,6 +278,27 @@ TypeSpecPtr Parser::parse_type_spec() {
     expect(Tok::RParen, "ST116", "to close the subrange");
   }
   return spec;
+}
+
+// The elementary integer types: the only bases of a typed enumeration or a subrange.
+bool Parser::is_integer_type_name(std::string_view name) {
+  static constexpr std::string_view kNames[] = {"SINT", "INT",  "DINT", "LINT",  "USINT", "UINT",
+                                                "UDINT", "ULINT", "BYTE", "WORD", "DWORD", "LWORD"};
+  for (std::string_view n : kNames)
+    if (iequals(name, n)) return true;
+  return false;
+}
+
+// At '(': whether a '..' follows at the first level of the parentheses (a subrange).
+bool Parser::subrange_follows() const {
+  int depth = 0;
+  for (size_t k = 0;; ++k) {
+    const Tok kind = la(k).kind;
+    if (kind == Tok::Eof || kind == Tok::Semi) return false;
+    if (kind == Tok::LParen || kind == Tok::LBracket) ++depth;
+    if ((kind == Tok::RParen || kind == Tok::RBracket) && --depth == 0) return false;
+    if (kind == Tok::DotDot && depth == 1) return true;
+  }
 }
 
 // return_type := type_spec   (after FUNCTION name ':' / METHOD name ':')

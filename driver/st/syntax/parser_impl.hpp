@@ -265,6 +265,8 @@ class Parser {
   ExprPtr parse_typed_literal();
   std::unique_ptr<LiteralExpr> literal_from(const Token& t);
   void parse_call_args(std::vector<CallArg>& args, const std::string& callee);
+  static bool is_integer_type_name(std::string_view name);
+  bool subrange_follows() const;
   ExprPtr parse_initializer();
 
   // ------------------------------------------------------------ statements (parse_stmts.cpp)

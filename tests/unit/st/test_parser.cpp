@@ -324,6 +324,18 @@ TEST(ParserDecl, TypeSpecs) {
             "ARRAY[1..2, 1..2] OF INT := [[1, 2], [3, 4]]");
 }
 
+// `fb : FB_X(...)` holds FB_init's arguments; an elementary integer type before '(' is
+// still a typed enumeration or a subrange, and so is any type with '..' in the parentheses.
+TEST(ParserDecl, FbInitArguments) {
+  EXPECT_EQ(var_type("x : FB_Log('pump', nSize := 3);"), "(FB_init FB_Log 'pump' (nSize := 3))");
+  EXPECT_EQ(var_type("x : FB_Log();"), "(FB_init FB_Log)");
+  EXPECT_EQ(var_type("x : Lib.FB_Log(n := 1);"), "(FB_init FB_Log (n := 1))");
+  EXPECT_EQ(var_type("x : FB_Log(a := f(1, 2), b := (1 + 2));"), "(FB_init FB_Log (a := (call f 1 2)) (b := (+ 1 2)))");
+  EXPECT_EQ(var_type("x : UDINT (A := 1);"), "(A := 1) UDINT");
+  EXPECT_EQ(var_type("x : MyInt (lo..hi);"), "MyInt (lo..hi)");
+  EXPECT_EQ(var_type("x : MyInt (f(1)..10);"), "MyInt ((call f 1)..10)");
+}
+
 TEST(ParserDecl, VarBlocks) {
   auto p = unit(
       "FUNCTION_BLOCK fb\n"
