@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "codegen/compiler.hpp"
+#include "import/import.hpp"
 
 namespace plcfi::cli {
 
@@ -115,10 +116,14 @@ inline void add_dialect_options(boost::program_options::options_description& des
       ("strict", "with --dialect codesys: the dialect's implicit conversions are errors");
 }
 // The dialect options into `opt`; a dialect that does not exist is a usage error.
+// Without --dialect, TwinCAT project files are read as what they are: CODESYS ST.
 inline void apply_dialect_options(const boost::program_options::variables_map& vm, st::CompileOptions* opt) {
   const std::string& d = vm["dialect"].as<std::string>();
   if (!st::parse_dialect(d, &opt->dialect))
     throw boost::program_options::error("--dialect must be iec or codesys, not '" + d + "'");
+  if (vm["dialect"].defaulted() && vm.count("files"))
+    for (const auto& f : vm["files"].as<std::vector<std::string>>())
+      if (st::input_kind(f) == st::InputKind::TwinCat) opt->dialect = st::Dialect::Codesys;
   opt->strict = vm.count("strict") != 0;
 }
 
