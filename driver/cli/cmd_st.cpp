@@ -191,6 +191,13 @@ int cmd_run(const std::vector<std::string>& args) {
   st::Machine m(app);
   m.set_budget(vm["budget"].as<Count>().value);
   m.set_native(native.get());
+  int status = 0;
+  std::string trap_text;
+  // The start: FB_init of every instance (CODESYS); --set values then override.
+  if (!m.cold_restart()) {
+    trap_text = st::describe_trap(app, m.trap()) + " (in FB_init at the start)";
+    status = 1;
+  }
   if (vm.count("set")) {
     for (const auto& s : vm["set"].as<std::vector<std::string>>()) {
       auto eq = s.find('=');
@@ -217,8 +224,6 @@ int cmd_run(const std::vector<std::string>& args) {
     }
   }
   uint64_t cycles = vm["cycles"].as<Count>().value;
-  int status = 0;
-  std::string trap_text;
   uint64_t done = 0;
   for (uint64_t n = 0; n < cycles && status == 0; ++n) {
     m.set_now(static_cast<int64_t>(n) * sched.tick_ns());

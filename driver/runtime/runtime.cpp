@@ -27,14 +27,19 @@ uint32_t Runtime::out_extent() const {
 }
 
 void Runtime::restart(uint64_t seed, bool warm) {
-  if (warm) machine_.warm_restart();
-  else machine_.cold_restart();
+  const bool ok = warm ? machine_.warm_restart() : machine_.cold_restart();
   std::fill(raw_in_.begin(), raw_in_.end(), 0);
   std::fill(out_.begin(), out_.end(), 0);
   now_ns_ = 0;
   scans_ = 0;
   stopped_ = false;
   stop_reason_.clear();
+  // A trap in FB_init or FB_exit: the program does not start.
+  trap_at_restart_ = !ok;
+  if (!ok) {
+    stopped_ = true;
+    stop_reason_ = st::describe_trap(*app_, machine_.trap()) + " (in FB_init/FB_exit at the restart)";
+  }
   machine_.set_now(0);
   if (backend_) backend_->reset(seed);
 }
@@ -109,6 +114,9 @@ ScanStatus Runtime::scan() {
       stopped_ = true;
       status = ScanStatus::Trapped;
     }
+  } else if (trap_at_restart_) {
+    trap_at_restart_ = false;  // the first scan reports it, as it would a trap of its own
+    status = ScanStatus::Trapped;
   } else if (status == ScanStatus::Ok) {
     status = ScanStatus::Stopped;
   }

@@ -111,6 +111,7 @@ class Runtime {
   int64_t now_ns_ = 0;
   uint64_t scans_ = 0;
   bool stopped_ = false;
+  bool trap_at_restart_ = false;  // FB_init or FB_exit trapped: the next scan says Trapped
   std::string stop_reason_;
 };
 

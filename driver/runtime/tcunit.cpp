@@ -138,7 +138,10 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
   }
 
   m.set_budget(opt.budget);
-  m.cold_restart();
+  if (!m.cold_restart()) {
+    rep.program_trap = st::describe_trap(app, m.trap()) + " (in FB_init/FB_exit at the restart)";
+    return rep;
+  }
   const int64_t tick = schedule.tick_ns();
   uint64_t n = 0;
   auto pending = [&] {

@@ -569,9 +569,13 @@ std::string disassemble(const Application& app, const Build* build) {
   for (const auto& p : app.pous) {
     if (p->is_stdlib || !p->compiled) continue;
     if (p->kind != PouKind::Interface && !p->is_test) heads[p->entry] = p->name;
+    if (p->has_init) heads[p->init_entry] = p->name + " (FB_init of its instances)";
+    if (p->has_exit) heads[p->exit_entry] = p->name + " (FB_exit of its instances)";
     for (const auto& m : p->methods)
       if (m->compiled && m->has_body) heads[m->entry] = p->name + "." + m->name;
   }
+  if (app.has_init) heads[app.init_entry] = "FB_init of the application's instances";
+  if (app.has_exit) heads[app.exit_entry] = "FB_exit of the application's instances";
   for (const auto& t : app.tests) {
     heads[t.setup_entry] = "TEST '" + t.name + "' (setup)";
     heads[t.body_entry] = "TEST '" + t.name + "'";

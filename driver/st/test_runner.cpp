@@ -14,27 +14,36 @@ std::vector<TestResult> run_tests(const Application& app, Machine& m, const Test
     r.name = t.name;
     r.loc = t.loc;
     auto start = std::chrono::steady_clock::now();
-    m.cold_restart();
+    const bool restarted = m.cold_restart();
+    bool ok = restarted;
     m.set_now(0);
-    bool ok = true;
+    auto trapped = [&](const char* what) {
+      const Trap& tr = m.trap();
+      r.where = app.where(tr.loc);
+      // The result is shown after its location (r.where); SETUP and TEARDOWN say which
+      // phase the trap came from.
+      r.message = tr.kind == TrapKind::AssertFailed ? tr.message
+                  : what                             ? std::string(what) + ": " + describe_trap_kind(tr)
+                                                     : describe_trap_kind(tr);
+    };
+    if (!ok) trapped("in FB_init/FB_exit at the restart");
     auto phase = [&](uint32_t entry, const char* what) {
       if (!m.call(entry, t.instance_addr)) {
-        const Trap& tr = m.trap();
-        r.where = app.where(tr.loc);
-        // The result is shown after its location (r.where); SETUP and TEARDOWN say which
-        // phase the trap came from.
-        r.message = tr.kind == TrapKind::AssertFailed ? tr.message
-                    : what                             ? std::string(what) + ": " + describe_trap_kind(tr)
-                                                       : describe_trap_kind(tr);
+        trapped(what);
         return false;
       }
       return true;
     };
-    if (t.has_setup) ok = phase(t.setup_entry, "in SETUP");
+    if (ok && t.has_init) ok = phase(t.init_entry, "in FB_init");
+    if (ok && t.has_setup) ok = phase(t.setup_entry, "in SETUP");
     if (ok) ok = phase(t.body_entry, nullptr);
-    if (t.has_teardown) {
+    if (t.has_teardown && restarted) {
       bool td = phase(t.teardown_entry, "in TEARDOWN");
       if (ok && !td) ok = false;
+    }
+    if (t.has_exit && restarted) {
+      if (ok) ok = phase(t.exit_entry, "in FB_exit");
+      else (void)m.call(t.exit_entry, t.instance_addr);  // the first failure is the one reported
     }
     m.merge_coverage();
     m.clear_taken();

@@ -447,20 +447,36 @@ void Compiler::declare_pou(PouInfo* p) {
 // from the frame right after the call, before any destination is evaluated, for the same
 // reason.
 Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt) {
-  if (is_tcunit_method(m) && !(m = tcunit_lowering(c, m))) return bad();
-  declare_pou(m);
   (void)inst;
+  if (is_tcunit_method(m) && !(m = tcunit_lowering(c, m))) return bad();
+  return call_method(c.args, c.loc, m, this_ptr, virt, {});
+}
+
+Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouInfo* m, Slot this_ptr, bool virt,
+                          const std::vector<FixedArg>& fixed) {
+  declare_pou(m);
   std::vector<Symbol*> params = m->inputs;
   params.insert(params.end(), m->inouts.begin(), m->inouts.end());
   std::vector<const CallArg*> bound(params.size(), nullptr);
   std::vector<std::pair<Symbol*, const CallArg*>> outs;
   std::vector<size_t> order;  // bound parameters in the order their arguments are written
+  auto fixed_of = [&](const Symbol* p) -> const FixedArg* {
+    for (const auto& f : fixed)
+      if (f.param == p) return &f;
+    return nullptr;
+  };
+  // Positional arguments go to the parameters the compiler does not supply itself.
   size_t pos = 0;
-  for (const auto& a : c.args) {
+  while (pos < params.size() && fixed_of(params[pos])) ++pos;
+  for (const auto& a : args) {
     size_t idx = SIZE_MAX;
     if (a.name) {
       for (size_t i = 0; i < params.size(); ++i)
         if (iequals(params[i]->name, a.name->text)) idx = i;
+      if (idx != SIZE_MAX && fixed_of(params[idx])) {
+        diags_.error("ST212", a.loc, "'" + params[idx]->name + "' of " + m->name + " is set by the runtime, not by an argument");
+        continue;
+      }
       if (idx == SIZE_MAX) {
         for (Symbol* o : m->outputs)
           if (iequals(o->name, a.name->text)) outs.emplace_back(o, &a);
@@ -474,6 +490,10 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
         diags_.error("ST210", a.loc, "too many arguments for method " + m->name);
         break;
       }
+    }
+    if (bound[idx]) {
+      diags_.error("ST212", a.loc, "'" + params[idx]->name + "' of " + m->name + " is given twice");
+      continue;
     }
     bound[idx] = &a;
     order.push_back(idx);
@@ -535,23 +555,25 @@ Val Compiler::call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot
     field.type = p->where == Where::InOut ? elem(TypeKind::UDInt) : p->type;
     if (p->where == Where::InOut) {
       if (!bound[i] || !bound[i]->value) {
-        diags_.error("ST224", c.loc, "VAR_IN_OUT '" + p->name + "' of method " + m->name + " must be passed");
+        diags_.error("ST224", loc, "VAR_IN_OUT '" + p->name + "' of method " + m->name + " must be passed");
         continue;
       }
       if (staged[i].ok) store(field, staged[i].v.slot);
       continue;
     }
-    if (bound[i] && bound[i]->value) {
+    if (const FixedArg* f = fixed_of(p)) {
+      assign(field, f->v, loc);
+    } else if (bound[i] && bound[i]->value) {
       if (!staged[i].ok) continue;
       if (staged[i].direct) assign(field, staged[i].v, bound[i]->loc);
       else store(field, staged[i].v.slot);
     } else if (is_tcunit_method(m) && iequals(p->name, "_tcuAt")) {
-      store(field, konst_i64(pack_location(c.loc)));  // where the assertion is, for its failure
+      store(field, konst_i64(pack_location(loc)));  // where the assertion is, for its failure
     } else {
       store(field, konst_bytes(p->init.data(), static_cast<uint32_t>(p->init.size()), p->type->align));
     }
   }
-  mark(c.loc);
+  mark(loc);
   if (virt) emit(Op::CALLV, {frame, this_ptr, m->selector});
   else emit(Op::CALLS, {frame, Arg::entry(m)});
   auto frame_field = [&](uint32_t off, const Type* t) {

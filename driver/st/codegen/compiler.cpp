@@ -159,7 +159,7 @@ void Compiler::emit_list(Op op, const std::vector<Arg>& args) {
         if (a.sk != SK::Var) b_->slot_fix.emplace_back(static_cast<uint32_t>(code.size()), a.sk);
         break;
       case Arg::K::Target: b_->target_fix.emplace_back(static_cast<uint32_t>(code.size()), a.v); break;
-      case Arg::K::Entry: b_->entry_fix.emplace_back(static_cast<uint32_t>(code.size()), a.pou); break;
+      case Arg::K::Entry: b_->entry_fix.push_back({static_cast<uint32_t>(code.size()), a.pou, static_cast<EntryKind>(a.v)}); break;
     }
     code.push_back(a.k == Arg::K::Slot || a.k == Arg::K::Imm ? a.v : 0);
   }
@@ -329,8 +329,14 @@ void Compiler::compile_pou(PouInfo* p) {
     emit(Op::MOV8, {seen, Slot{state_in->offset, SK::Var}});
     emit(Op::JMP, {Arg::target(body_start.id)});
   }
+  size_t init_at = 0, exit_at = 0;
+  if (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) lifecycle_entries(p, &entries, &init_at, &exit_at);
   finish_body(*body, p, &entries);
   p->entry = entries[0];
+  if (init_at) p->init_entry = entries[init_at];
+  if (exit_at) p->exit_entry = entries[exit_at];
+  p->has_init = init_at != 0;
+  p->has_exit = exit_at != 0;
   p->compiled = true;
   compiling_.pop_back();
 
@@ -425,7 +431,7 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
     }
     b.code[idx] = base + target;
   }
-  for (auto [idx, pou] : b.entry_fix) entry_fix_.emplace_back(base + idx, pou);
+  for (EntryFix f : b.entry_fix) entry_fix_.push_back({base + f.at, f.pou, f.kind});
   for (auto [pc, loc] : b.lines) app_->lines.emplace_back(base + pc, loc);
   app_->code.insert(app_->code.end(), b.code.begin(), b.code.end());
   p->code_begin = base;
@@ -472,7 +478,13 @@ void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
     if (part) stmts(*part);
     emit(Op::RET, {});
   }
+  size_t init_at = 0, exit_at = 0;
+  lifecycle_entries(p, &entries, &init_at, &exit_at);
   finish_body(*body, p, &entries);
+  if (init_at) p->init_entry = entries[init_at];
+  if (exit_at) p->exit_entry = entries[exit_at];
+  p->has_init = init_at != 0;
+  p->has_exit = exit_at != 0;
   p->compiled = true;
   bodies_.push_back(std::move(body));
   b_ = saved_b;
@@ -487,6 +499,10 @@ void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
   te.teardown_entry = entries[2];
   te.has_setup = tf.setup.has_value();
   te.has_teardown = tf.teardown.has_value();
+  te.has_init = p->has_init;
+  te.has_exit = p->has_exit;
+  te.init_entry = p->init_entry;
+  te.exit_entry = p->exit_entry;
   app_->tests.push_back(te);
   app_->pous.push_back(std::move(pi));
 }
@@ -734,7 +750,8 @@ void Compiler::configure(const std::vector<const CompilationUnit*>& units) {
 // Entries of called POUs, the dispatch table, and the declared types by name (for units
 // linked later).
 void Compiler::finish_link() {
-  for (auto [idx, pou] : entry_fix_) app_->code[idx] = pou->entry;
+  for (EntryFix f : entry_fix_)
+    app_->code[f.at] = f.kind == EntryKind::Init ? f.pou->init_entry : f.kind == EntryKind::Exit ? f.pou->exit_entry : f.pou->entry;
   app_->n_types = next_type_id_;
   app_->vtable.assign(static_cast<size_t>(next_selector_) * app_->n_types, 0);
   for (const auto& p : app_->pous) {
@@ -780,6 +797,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
 
   for (const auto* tf : tests)
     for (const auto& tc : tf->tests) compile_test(*tf, tc);
+  compile_lifecycle();
 
   // Method frames live on a small stack of their own.
   app_->mstack_size = 64 * 1024;

@@ -39,6 +39,15 @@ struct Slot {
   Slot plus(uint32_t d) const { return Slot{off + d, kind}; }
 };
 
+// Which code of a POU a call goes to: its body, or (FB/PROGRAM) the entry that runs
+// FB_init or FB_exit of the instances it holds.
+enum class EntryKind : uint8_t { Body, Init, Exit };
+struct EntryFix {
+  uint32_t at;  // code index of the operand
+  PouInfo* pou;
+  EntryKind kind;
+};
+
 // One instruction operand word.
 struct Arg {
   enum class K : uint8_t { Imm, Slot, Target, Entry } k = K::Imm;
@@ -53,8 +62,8 @@ struct Arg {
     a.k = K::Target;
     return a;
   }
-  static Arg entry(PouInfo* p) {
-    Arg a(0u);
+  static Arg entry(PouInfo* p, EntryKind which = EntryKind::Body) {
+    Arg a(static_cast<uint32_t>(which));
     a.k = K::Entry;
     a.pou = p;
     return a;
@@ -110,7 +119,7 @@ struct Body {
   std::vector<uint32_t> label_pos;                         // label id -> body-relative pc
   std::vector<std::pair<uint32_t, uint32_t>> target_fix;   // (code index, label id)
   std::vector<std::pair<uint32_t, SK>> slot_fix;           // (code index, kind) for Temp/Const
-  std::vector<std::pair<uint32_t, PouInfo*>> entry_fix;    // (code index, POU) -> entry
+  std::vector<EntryFix> entry_fix;
   std::vector<uint32_t> template_fix;                      // code index -> this POU's template address
   std::vector<uint8_t> consts;
   std::map<std::pair<std::string, uint32_t>, uint32_t> const_index;
@@ -311,7 +320,38 @@ class Compiler {
   Val call_function(PouInfo* f, const CallExpr& c);
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
+  // A value the compiler passes for a parameter (FB_init's bInitRetains and bInCopyCode):
+  // no argument may name it, and positional arguments start after it.
+  struct FixedArg {
+    Symbol* param;
+    Val v;
+  };
+  Val call_method(const std::vector<CallArg>& args, SourceLoc loc, PouInfo* m, Slot this_ptr, bool virt,
+                  const std::vector<FixedArg>& fixed);
   void store_outputs(const std::vector<std::pair<Symbol*, const CallArg*>>& outs, const std::vector<Val>& out_vals);
+  // ---- FB_init and FB_exit (lifecycle.cpp)
+  // Whether an instance of t (an FB, or an array or structure holding FBs) has FB_init
+  // (exit: FB_exit) to run, itself or in what it holds. Only under --dialect codesys.
+  bool lifecycle_needed(const Type* t, bool exit);
+  // Whether the instances p holds (its own variables and its base FB's) need it.
+  bool members_need(PouInfo* p, bool exit);
+  // Calls the init or exit entry of pou on the instance at `at` (a frame or global place).
+  void call_entry(const Place& at, PouInfo* pou, EntryKind which);
+  // FB_init (FB_exit) of the instance at `at` of type t and of all it holds; d: its
+  // declaration, whose arguments FB_init gets.
+  void instance_lifecycle(const Place& at, const Type* t, const VarDecl* d, bool exit, SourceLoc loc);
+  // A declaration `fb : FB_X(args)`: errors when args are not allowed there (allowed:
+  // what the caller of resolve_type said in init_args_ok_), t is no FB or has no FB_init.
+  void check_init_args(const TypeSpec& spec, const Type* t, bool allowed);
+  bool init_args_ok_ = false;
+  // The BOOL the restart sets for bInitRetains.
+  uint32_t init_flag_addr();
+  // p's init and exit entries, after its body; their indices in *entries.
+  void lifecycle_entries(PouInfo* p, std::vector<uint32_t>* entries, size_t* init_at, size_t* exit_at);
+  // The application's routine over program instances and globals.
+  void compile_lifecycle();
+  std::unordered_map<const Type*, bool> lifecycle_memo_[2];
+
   // ---- TcUnit (tcunit.cpp, with stdlib/tcunit.cpp)
   // A method of the library's FB_TestSuite.
   static bool is_tcunit_method(const PouInfo* m);
@@ -397,7 +437,7 @@ class Compiler {
   std::unordered_map<std::string, uint32_t> selectors_;
   uint32_t next_selector_ = 0;
   std::vector<PouInfo*> all_methods_;
-  std::vector<std::pair<uint32_t, PouInfo*>> entry_fix_;  // absolute code index -> POU entry
+  std::vector<EntryFix> entry_fix_;  // absolute code index -> POU entry
   mutable std::unordered_map<std::string, std::unique_ptr<Symbol>> enum_syms_;  // made on first lookup
   const Type* null_type_ = nullptr;
   const PouInfo* decl_pou_ = nullptr;  // POU whose declarations are being laid out

@@ -182,6 +182,10 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
   uint32_t saved = file_;
   file_ = file;
   const Type* result = nullptr;
+  // FB_init arguments are taken only by the declaration a caller allowed them in, never by
+  // a type inside it (ARRAY OF FB_X(...), a structure's member).
+  const bool init_args_ok = init_args_ok_;
+  init_args_ok_ = false;
   switch (spec.kind) {
     case TypeSpecKind::Named: {
       std::string c = canon(spec.name.text);
@@ -196,6 +200,7 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
         break;
       }
       result = named_type(spec.name, file);
+      if (result && spec.has_init_args) check_init_args(spec, result, init_args_ok);
       break;
     }
     case TypeSpecKind::Array: {
@@ -816,7 +821,9 @@ bool Compiler::locate(const DirectAddrExpr& a, const Type* t, uint32_t* addr, ui
 void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::string& scope, uint32_t file) {
   for (const auto& blk : blocks) {
     for (const auto& d : blk.decls) {
+      init_args_ok_ = !d.location;
       const Type* t = d.type ? resolve_type(*d.type, file) : nullptr;
+      init_args_ok_ = false;
       if (!t) continue;
       for (const auto& n : d.names) {
         std::string key = canon(n.text);
@@ -858,6 +865,27 @@ void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::s
       }
     }
   }
+}
+
+void Compiler::check_init_args(const TypeSpec& spec, const Type* t, bool allowed) {
+  const SourceLoc at = spec.init_args.empty() ? spec.loc : spec.init_args.front().loc;
+  if (!allowed) {
+    diags_.error("ST243", at, "FB_init arguments can be given only to an instance declared in a PROGRAM's or "
+                              "FUNCTION_BLOCK's VAR, VAR_INPUT or VAR_OUTPUT block or in a global variable list");
+    return;
+  }
+  if (opt_.dialect == Dialect::Iec) {
+    diags_.error("ST241", at, "FB_init arguments in a declaration are CODESYS, not IEC 61131-3: use --dialect codesys");
+    return;
+  }
+  if (t->kind != TypeKind::Pou || !t->pou || t->pou->kind != PouKind::FunctionBlock) {
+    diags_.error("ST243", at, "'" + spec.name.text + "' is not a function block: only an instance takes FB_init arguments");
+    return;
+  }
+  for (const PouInfo* f = t->pou; f; f = f->base)
+    for (const auto& m : f->methods)
+      if (iequals(m->name, "FB_init") && m->has_body) return;
+  diags_.error("ST243", at, t->pou->name + " has no FB_init method to take these arguments");
 }
 
 std::string Compiler::inst_var_name(const PouInfo* method, const std::string& var) {
@@ -1010,7 +1038,10 @@ void Compiler::declare_vars(PouInfo* p) {
           diags_.error("ST240", d.loc, p->name + " cannot contain an instance of itself");
           continue;
         }
+        init_args_ok_ = (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) &&
+                        (sec == VarSection::Var || sec == VarSection::Input || sec == VarSection::Output);
         const Type* t = d.type ? resolve_type(*d.type, p->file) : nullptr;
+        init_args_ok_ = false;
         if (!t) continue;
         if (t->kind == TypeKind::Pou && t->pou == p) {
           diags_.error("ST240", d.loc, p->name + " cannot contain an instance of itself");

@@ -146,9 +146,13 @@ class Translator {
       work.push_back(t.setup_entry);
       work.push_back(t.body_entry);
       work.push_back(t.teardown_entry);
+      if (t.has_init) work.push_back(t.init_entry);
+      if (t.has_exit) work.push_back(t.exit_entry);
     }
     for (uint32_t e : app_.vtable)
       if (e) work.push_back(e);
+    if (app_.has_init) work.push_back(app_.init_entry);
+    if (app_.has_exit) work.push_back(app_.exit_entry);
     std::set<uint32_t> all_entries;  // every entry, to bound functions
     for (const auto& p : app_.pous)
       if (p->compiled) all_entries.insert(p->entry);

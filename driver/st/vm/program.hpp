@@ -107,6 +107,10 @@ struct PouInfo {
   StateShift shift;         // late PROGRAMs with __state
   bool is_stdlib = false;
   bool is_test = false;     // a TEST of a test file: its entries are in Application::tests
+  // FB/PROGRAM (CODESYS): entries after the body, on an instance as base, that run FB_init
+  // (FB_exit) of the instances it holds (the base FB's first), not the instance's own.
+  bool has_init = false, has_exit = false;
+  uint32_t init_entry = 0, exit_entry = 0;
 
   Symbol* find_var(std::string_view name) const;
   PouInfo* find_method(std::string_view name) const;  // searches bases too
@@ -139,6 +143,10 @@ struct TestEntry {
   uint32_t instance_addr = 0;
   uint32_t setup_entry = 0, body_entry = 0, teardown_entry = 0;
   bool has_setup = false, has_teardown = false;
+  // FB_init (FB_exit) of the instances the test's frame holds (CODESYS): run by the test
+  // runner after the restart (after TEARDOWN).
+  bool has_init = false, has_exit = false;
+  uint32_t init_entry = 0, exit_entry = 0;
 };
 
 struct GlobalVar {
@@ -175,6 +183,11 @@ class Application {
   std::unique_ptr<TypeTable> types;
   std::vector<std::pair<std::string, const Type*>> type_names;  // declared TYPEs, as spelt
   bool has_configuration = false;
+  // FB_init/FB_exit (CODESYS): a routine over every program instance and global instance,
+  // run by Machine::cold_restart/warm_restart on the frame at lifecycle_addr.
+  // The byte at init_flag_addr is what FB_init gets as bInitRetains.
+  bool has_init = false, has_exit = false;
+  uint32_t init_entry = 0, exit_entry = 0, lifecycle_addr = 0, init_flag_addr = 0;
 
   SourceLoc loc_of(uint32_t pc) const;
   std::string where(SourceLoc loc) const;  // "file:line:col"

@@ -55,17 +55,37 @@ Machine::Machine(const Application& app) : app_(&app) {
   covered_.assign(words, 0);
 }
 
-void Machine::cold_restart() { std::memcpy(mem_.data(), app_->init_image.data(), mem_.size()); }
+bool Machine::cold_restart() { return restart(false); }
+bool Machine::warm_restart() { return restart(true); }
 
-void Machine::warm_restart() {
-  std::vector<uint8_t> keep;
-  for (auto [addr, size] : app_->retain_ranges) keep.insert(keep.end(), mem_.begin() + addr, mem_.begin() + addr + size);
-  cold_restart();
-  size_t pos = 0;
-  for (auto [addr, size] : app_->retain_ranges) {
-    std::memcpy(mem_.data() + addr, keep.data() + pos, size);
-    pos += size;
+bool Machine::restart(bool warm) {
+  bool ok = true;
+  Trap first;
+  // FB_exit of the instances that ran, while their memory is still theirs.
+  if (app_->has_exit && started_ && !call(app_->exit_entry, app_->lifecycle_addr)) {
+    ok = false;
+    first = trap_;
   }
+  std::vector<uint8_t> keep;
+  if (warm)
+    for (auto [addr, size] : app_->retain_ranges) keep.insert(keep.end(), mem_.begin() + addr, mem_.begin() + addr + size);
+  std::memcpy(mem_.data(), app_->init_image.data(), mem_.size());
+  size_t pos = 0;
+  if (warm)
+    for (auto [addr, size] : app_->retain_ranges) {
+      std::memcpy(mem_.data() + addr, keep.data() + pos, size);
+      pos += size;
+    }
+  started_ = true;
+  if (app_->has_init) {
+    mem_[app_->init_flag_addr] = warm ? 0 : 1;
+    if (!call(app_->init_entry, app_->lifecycle_addr) && ok) {
+      ok = false;
+      first = trap_;
+    }
+  }
+  trap_ = ok ? Trap{} : first;
+  return ok;
 }
 
 void Machine::clear_taken() { std::fill(taken_.begin(), taken_.end(), 0); }

@@ -61,10 +61,13 @@ class Machine {
  public:
   explicit Machine(const Application& app);
 
-  // Memory := the application's cold-start image (all variables to initial values).
-  void cold_restart();
-  // Like cold_restart, but RETAIN variables keep their values.
-  void warm_restart();
+  // Memory := the application's cold-start image (all variables to initial values); then,
+  // in a CODESYS program, FB_init of every instance (bInitRetains = TRUE). An application
+  // that ran before gets FB_exit of every instance first. False when one of them trapped
+  // (see trap()): the memory is reset all the same.
+  bool cold_restart();
+  // Like cold_restart, but RETAIN variables keep their values (bInitRetains = FALSE).
+  bool warm_restart();
 
   // Runs code at `entry` with base = absolute address `base_addr` until it returns.
   // Returns false on a trap (see trap()); memory stays consistent and the machine usable.
@@ -99,6 +102,7 @@ class Machine {
  private:
   friend struct VmAccess;
   friend struct NativeBridge;
+  bool restart(bool warm);
   bool fail(TrapKind k, const uint32_t* pc, std::string msg);
   // Interprets from pc until the matching RET. mtop: the method stack top; budget: the
   // backward jumps left (read and, on a normal return, written back).
@@ -114,6 +118,7 @@ class Machine {
   Trap trap_;
   std::string assert_message_;
   const NativeCode* native_ = nullptr;
+  bool started_ = false;  // restarted at least once: FB_exit is due before the next restart
   struct Frame {
     const uint32_t* pc;
     uint8_t* base;

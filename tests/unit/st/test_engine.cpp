@@ -423,5 +423,80 @@ TEST(EngineRestart, WarmRestartKeepsOnlyRetainVariables) {
   EXPECT_EQ(1, read_int(m, kept));
 }
 
+
+// FB_init and FB_exit (CODESYS): FB_init at every restart with bInitRetains TRUE on a cold
+// start and FALSE on a warm one; FB_exit of the instances that ran before the next restart.
+const char* kLifecycle = R"(VAR_GLOBAL RETAIN exits : INT; END_VAR
+VAR_GLOBAL inits : INT; retains : BOOL; divisor : INT := 1; END_VAR
+FUNCTION_BLOCK Counted
+METHOD FB_init : BOOL
+VAR_INPUT bInitRetains : BOOL; bInCopyCode : BOOL; END_VAR
+inits := inits + 100 / divisor;
+retains := bInitRetains;
+END_METHOD
+METHOD FB_exit : BOOL
+VAR_INPUT bInCopyCode : BOOL; END_VAR
+exits := exits + 1;
+END_METHOD
+END_FUNCTION_BLOCK
+PROGRAM Main
+VAR a, b : Counted; END_VAR
+END_PROGRAM
+)";
+
+TEST(EngineRestart, FbInitAndFbExitRunAtEveryRestart) {
+  CompileOptions opt;
+  opt.dialect = Dialect::Codesys;
+  auto b = build_sources({{"lifecycle.st", kLifecycle}}, opt);
+  ASSERT_TRUE(b->ok()) << b->diags.render_all();
+  Machine m(*b->app);
+  std::string err;
+  VarHandle inits = *resolve(*b->app, "inits", &err), exits = *resolve(*b->app, "exits", &err),
+            retains = *resolve(*b->app, "retains", &err), divisor = *resolve(*b->app, "divisor", &err);
+  EXPECT_EQ(0, read_int(m, inits)) << "a new machine holds the cold-start image";
+  ASSERT_TRUE(m.cold_restart()) << m.trap().message;
+  EXPECT_EQ(200, read_int(m, inits));
+  EXPECT_EQ(0, read_int(m, exits)) << "nothing ran before the first restart";
+  EXPECT_EQ(1, read_int(m, retains));
+
+  ASSERT_TRUE(m.warm_restart()) << m.trap().message;
+  EXPECT_EQ(200, read_int(m, inits)) << "reset, then initialised again";
+  EXPECT_EQ(2, read_int(m, exits)) << "one FB_exit per instance, kept by the warm restart";
+  EXPECT_EQ(0, read_int(m, retains));
+
+  ASSERT_TRUE(m.warm_restart()) << m.trap().message;
+  EXPECT_EQ(4, read_int(m, exits));
+  ASSERT_TRUE(m.cold_restart()) << m.trap().message;
+  EXPECT_EQ(0, read_int(m, exits));
+
+  // A trap in FB_init: the restart says so and names the place.
+  write_int(m, divisor, 0);
+  ASSERT_TRUE(m.warm_restart()) << "divisor is reset to 1 before FB_init runs";
+  EXPECT_EQ(200, read_int(m, inits));
+}
+
+TEST(EngineRestart, ATrapInFbInitFailsTheRestart) {
+  CompileOptions opt;
+  opt.dialect = Dialect::Codesys;
+  std::string src = kLifecycle;
+  src.replace(src.find("divisor : INT := 1"), 18, "divisor : INT := 0");
+  auto b = build_sources({{"lifecycle.st", src}}, opt);
+  ASSERT_TRUE(b->ok()) << b->diags.render_all();
+  Machine m(*b->app);
+  EXPECT_FALSE(m.cold_restart());
+  EXPECT_EQ(TrapKind::DivisionByZero, m.trap().kind);
+  EXPECT_EQ("lifecycle.st:6:", b->app->where(m.trap().loc).substr(0, 15)) << "the division in FB_init";
+}
+
+TEST(EngineRestart, FbInitIsCodesysOnly) {
+  auto b = build_sources({{"lifecycle.st", kLifecycle}}, CompileOptions{});
+  ASSERT_TRUE(b->ok()) << b->diags.render_all();
+  EXPECT_FALSE(b->app->has_init) << "under --dialect iec FB_init is a method like any other";
+  Machine m(*b->app);
+  ASSERT_TRUE(m.cold_restart());
+  std::string err;
+  EXPECT_EQ(0, read_int(m, *resolve(*b->app, "inits", &err)));
+}
+
 }  // namespace
 }  // namespace plcfi::st
