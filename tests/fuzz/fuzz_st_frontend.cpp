@@ -1,5 +1,7 @@
 // Fuzz target: the ST front end (lexer, parser, semantic checks, bytecode compiler) on one
-// source; a program that compiles runs a few scans under a small VM budget (the watchdog).
+// source; a program that compiles restarts (FB_init) and runs a few scans under a small VM
+// budget (the watchdog). A source that holds the comment `(* dialect: codesys *)` is
+// compiled as CODESYS ST (the seeds of CODESYS constructs carry it), any other as IEC.
 #include <cstdint>
 #include <string>
 
@@ -19,7 +21,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace plcfi;
   st::CompileOptions opt;
   opt.warnings = true;
-  auto b = st::build_sources({{"fuzz.st", std::string(fuzz::as_text(data, size))}}, opt);
+  std::string text(fuzz::as_text(data, size));
+  if (text.find("(* dialect: codesys *)") != std::string::npos) opt.dialect = st::Dialect::Codesys;
+  auto b = st::build_sources({{"fuzz.st", std::move(text)}}, opt);
   (void)b->diags.render_all();
   if (!b->ok()) return 0;
   const st::Application& app = *b->app;
@@ -30,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!scheduled) return 0;
   st::Machine m(app);
   m.set_budget(kBudget);
-  bool trapped = false;
+  bool trapped = !m.cold_restart();
   for (uint64_t n = 0; n < kScans && !trapped; ++n) {
     m.set_now(static_cast<int64_t>(n) * sched.tick_ns());
     m.clear_taken();
