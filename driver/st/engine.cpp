@@ -32,10 +32,10 @@ void map_imported(Application& app, const SourceManager& sm, const std::set<uint
   for (auto& task : app.tasks) map(task.loc);
 }
 
-// TcUnit comes with the application when a source names its FB_TestSuite, unless a
-// source declares an FB_TestSuite of its own (a copy of TcUnit's sources in the project).
-bool uses_tcunit(const SourceManager& sm, const std::vector<uint32_t>& files) {
-  static const std::string key = "fb_testsuite";
+// A test library comes with the application when a source names its function block
+// (TcUnit: FB_TestSuite; FB_ASSERT), unless a source declares one of that name itself (a
+// copy of the library's sources in the project). key: the name in lower case.
+bool uses_library(const SourceManager& sm, const std::vector<uint32_t>& files, const std::string& key) {
   bool named = false;
   for (uint32_t f : files) {
     if (is_library_path(sm.file(f).path)) continue;
@@ -62,7 +62,8 @@ bool uses_tcunit(const SourceManager& sm, const std::vector<uint32_t>& files) {
 
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> files, const CompileOptions& opt,
                               const GeneratedSources& late, const std::set<uint32_t>& imported = {}) {
-  if (uses_tcunit(b->sm, files)) files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
+  if (uses_library(b->sm, files, "fb_testsuite")) files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
+  if (uses_library(b->sm, files, "fb_assert")) files.insert(files.begin() + 1, b->sm.add("<FB_ASSERT>", fb_assert_source()));
   for (uint32_t f : files) {
     if (is_test_file(b->sm, f)) b->tests.push_back(parse_test_file(b->sm, f, b->diags));
     else b->units.push_back(parse_unit(b->sm, f, b->diags));

@@ -50,10 +50,15 @@ const char* stdlib_source();
 // The TcUnit framework's ST source (FB_TestSuite, RUN), compiled with an application whose
 // sources use it (stdlib/tcunit.cpp).
 const char* tcunit_source();
+// FB_ASSERT (the assertion-FB style of TwinCAT unit tests), compiled with an application
+// whose sources use it (stdlib/tcunit.cpp).
+const char* fb_assert_source();
 // The location a TcUnit assertion's hidden input _tcuAt holds (codegen/tcunit.cpp).
 SourceLoc unpack_location(int64_t packed);
 // The libraries plcfi brings, loaded under these names: no warnings, mocks, coverage or
 // listing of their own. (Other sources in memory have names in angle brackets too.)
-inline bool is_library_path(const std::string& path) { return path == "<stdlib>" || path == "<TcUnit>"; }
+inline bool is_library_path(const std::string& path) {
+  return path == "<stdlib>" || path == "<TcUnit>" || path == "<FB_ASSERT>";
+}
 
 }  // namespace plcfi::st

@@ -352,8 +352,8 @@ class Compiler {
   void compile_lifecycle();
   std::unordered_map<const Type*, bool> lifecycle_memo_[2];
 
-  // ---- TcUnit (tcunit.cpp, with stdlib/tcunit.cpp)
-  // A method of the library's FB_TestSuite.
+  // ---- TcUnit and FB_ASSERT (tcunit.cpp, with stdlib/tcunit.cpp)
+  // A method of the library's FB_TestSuite or FB_ASSERT (they take the call's location).
   static bool is_tcunit_method(const PouInfo* m);
   // The call's location as the LINT the library's hidden input _tcuAt takes.
   static int64_t pack_location(SourceLoc loc);
@@ -361,6 +361,8 @@ class Compiler {
   // compares the arrays (native ARRAY_DIFF). The arguments are evaluated here and their
   // values left in preset_. Other methods come back unchanged; nullptr after an error.
   PouInfo* tcunit_lowering(const CallExpr& c, PouInfo* m);
+  PouInfo* memory_lowering(const CallExpr& c, PouInfo* m, const CallArg* e, const CallArg* a, const CallArg* size,
+                           const std::vector<const CallArg*>& in_order);
   // Values already computed for these expressions: expr() takes them (once) instead of
   // compiling the expression again.
   std::unordered_map<const Expr*, Val> preset_;

@@ -1,5 +1,6 @@
 // TcUnit calls the library (stdlib/tcunit.cpp) cannot express in ST: AssertEquals of ANY
 // type, and AssertArray*Equals_<T> of arrays of any bounds.
+#include <cstddef>
 #include <cstring>
 
 #include <fmt/format.h>
@@ -59,7 +60,7 @@ bool starts_with_ci(const std::string& s, std::string_view prefix) {
 }  // namespace
 
 bool Compiler::is_tcunit_method(const PouInfo* m) {
-  return m->is_stdlib && m->owner && iequals(m->owner->name, "FB_TestSuite");
+  return m->is_stdlib && m->owner && (iequals(m->owner->name, "FB_TestSuite") || iequals(m->owner->name, "FB_ASSERT"));
 }
 
 int64_t Compiler::pack_location(SourceLoc loc) {
@@ -70,7 +71,8 @@ int64_t Compiler::pack_location(SourceLoc loc) {
 PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
   const bool generic = iequals(m->name, "AssertEquals");
   const bool array = starts_with_ci(m->name, "AssertArray");
-  if (!generic && !array) return m;
+  const bool memory = iequals(m->name, "AreEqualMEM");
+  if (!generic && !array && !memory) return m;
   declare_pou(m);  // its inputs, for arguments by position
   // The argument bound to input `name` (by name, or by position among the inputs).
   auto arg = [&](std::string_view name) -> const CallArg* {
@@ -85,8 +87,8 @@ PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
     }
     return nullptr;
   };
-  const char* first = generic ? "Expected" : "Expecteds";
-  const char* second = generic ? "Actual" : "Actuals";
+  const char* first = generic || memory ? "Expected" : "Expecteds";
+  const char* second = generic || memory ? "Actual" : "Actuals";
   const CallArg* e = arg(first);
   const CallArg* a = arg(second);
   if (!e || !e->value || !a || !a->value) {
@@ -141,6 +143,8 @@ PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
     preset_[a->value.get()] = va;
     return typed;
   }
+
+  if (memory) return memory_lowering(c, m, e, a, arg("Size"), in_order);
 
   // AssertArrayEquals_<T>, AssertArray2dEquals_<T>, AssertArray3dEquals_<T>.
   const std::string rest = m->name.substr(std::strlen("AssertArray"));
@@ -199,6 +203,59 @@ PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
   preset_[e->value.get()] = diff;
   preset_[a->value.get()] = unused;
   if (d && d->value) preset_[d->value.get()] = delta;
+  return m;
+}
+
+// FB_ASSERT's AreEqualMEM(Expected, Actual, Size, Message): the Size bytes at two
+// addresses (ADR(x), a pointer or reference), compared by ARRAY_DIFF as arrays of BYTE
+// indexed from 0; the shape's counts are Size's value at run time.
+PouInfo* Compiler::memory_lowering(const CallExpr& c, PouInfo* m, const CallArg* e, const CallArg* a, const CallArg* size,
+                                   const std::vector<const CallArg*>& in_order) {
+  if (!size || !size->value) {
+    diags_.error("ST242", c.loc, "AreEqualMEM needs Size, the number of bytes to compare");
+    return nullptr;
+  }
+  Slot addr[2];
+  for (const CallArg* x : in_order) {
+    Val v = expr(*x->value, nullptr);
+    if (!v.ok) return nullptr;
+    if (!v.type || v.type->kind != TypeKind::Ref) {
+      diags_.error("ST242", x->loc, fmt::format("{} of AreEqualMEM is an address (ADR(x), a pointer), not {}",
+                                                x == e ? "Expected" : "Actual", v.type ? v.type->name : "a literal"));
+      return nullptr;
+    }
+    addr[x == e ? 0 : 1] = to_slot(v, v.type, x->loc);
+  }
+  const Type* udint = elem(TypeKind::UDInt);
+  Val bytes = expr_for(*size->value, udint);
+  if (!bytes.ok) return nullptr;
+  Slot n = to_slot(bytes, udint, size->loc);
+  Slot block = temp(16, 8);
+  store(frame_place(block, udint), addr[0]);
+  store(frame_place(block.plus(4), udint), addr[1]);
+  Val zero;
+  zero.type = elem(TypeKind::LReal);
+  zero.is_const = true;
+  zero.c.k = ConstV::K::Real;
+  assign(frame_place(block.plus(8), elem(TypeKind::LReal)), zero, c.loc);
+  ArrayDiffShape shape{};
+  shape.elem_size = shape.elem_size_a = 1;
+  shape.kind = static_cast<uint32_t>(ValueKind::U8);
+  shape.ndims = 1;
+  Slot shape_slot = temp(sizeof shape, 4);
+  emit(Op::MOVN, {shape_slot, konst_bytes(&shape, sizeof shape, 4), static_cast<uint32_t>(sizeof shape)});
+  for (size_t off : {offsetof(ArrayDiffShape, count_e), offsetof(ArrayDiffShape, count_a), offsetof(ArrayDiffShape, extent)})
+    store(frame_place(shape_slot.plus(static_cast<uint32_t>(off)), udint), n);
+  preset_[e->value.get()] = native(Native::ARRAY_DIFF, tt_->string_type(255, false), {block, shape_slot}, 255);
+  Val unused;
+  unused.type = elem(TypeKind::Bool);
+  unused.is_const = true;
+  unused.c.k = ConstV::K::Bool;
+  preset_[a->value.get()] = unused;
+  bytes.slot = n;
+  bytes.is_const = false;
+  bytes.type = udint;
+  preset_[size->value.get()] = bytes;
   return m;
 }
 
