@@ -1,4 +1,5 @@
 // ST engine commands: check, run, test, disasm.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -16,6 +17,7 @@
 #include "report/junit.hpp"
 #include "common/duration.hpp"
 #include "runtime/schedule.hpp"
+#include "runtime/fb_assert.hpp"
 #include "runtime/tcunit.hpp"
 #include "test_runner.hpp"
 
@@ -228,16 +230,7 @@ int cmd_run(const std::vector<std::string>& args) {
   for (uint64_t n = 0; n < cycles && status == 0; ++n) {
     m.set_now(static_cast<int64_t>(n) * sched.tick_ns());
     m.clear_taken();
-    sched.for_each_due(n, [&](const rt::ScheduledTask& t) {
-      for (size_t pi : t.programs) {
-        if (status) return;
-        const auto& inst = app.programs[pi];
-        if (!m.call(inst.pou->entry, inst.addr)) {
-          trap_text = st::describe_trap(app, m.trap()) + fmt::format(" (program {}, cycle {})", inst.name, n);
-          status = 1;
-        }
-      }
-    });
+    if (!sched.run_due(app, m, n, &trap_text)) status = 1;
     m.merge_coverage();
     if (status == 0) ++done;
   }
@@ -297,8 +290,8 @@ struct TestTally {
   }
 };
 
-// The schedule a TcUnit run scans: the configuration's tasks, or one program.
-bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt::Schedule* sched) {
+// The schedule a TcUnit or --until run scans: the configuration's tasks, or one program.
+bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt::Schedule* sched, const char* why) {
   std::string err;
   bool ok;
   if (app.has_configuration && !vm.count("program")) {
@@ -311,8 +304,92 @@ bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt
     }
     ok = sched->single_program(app, vm.count("program") ? vm["program"].as<std::string>() : "", cycle, &err);
   }
-  if (!ok) std::cerr << "plcfi test: TcUnit suites run in the scan of the program that calls TcUnit.RUN(): " << err << "\n";
+  if (!ok) std::cerr << "plcfi test: " << why << ": " << err << "\n";
   return ok;
+}
+
+// `plcfi test --until EXPR`: the program scans until EXPR holds; then FB_ASSERT's log is
+// reported, one group per unit under test. EXPR is compiled as a PROGRAM linked onto the
+// program, so it reaches every instance by path.
+int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileOptions& opt, int64_t timeout_ns) {
+  const std::string expr = vm["until"].as<std::string>();
+  if (!b.tests.empty()) {
+    std::cerr << "plcfi test: --until scans the program until a condition holds; it takes no test files "
+                 "(TEST ... END_TEST): run them without --until\n";
+    return 2;
+  }
+  const std::string head = "PROGRAM _PLCFI_UNTIL\nVAR_OUTPUT reached : BOOL; END_VAR\nreached := ";
+  st::LineOrigin origin;
+  origin.path = "--until";
+  origin.line = 1;
+  origin.col = 1;
+  origin.prefix = static_cast<uint32_t>(std::string("reached := ").size());
+  b.sm.add("--until", expr);  // the origin of the condition's line: errors point into the option's text
+  st::GeneratedSource src("<--until>", head + expr + ";\nEND_PROGRAM\n", {{}, {}, origin});
+  st::CompileOptions strict = opt;  // a condition: BOOL, not a number CODESYS would convert
+  strict.strict = true;
+  if (!st::link_generated(b, {src}, strict)) {
+    std::cerr << b.diags.render_all();
+    std::cerr << "plcfi test: --until '" << expr << "' is not a BOOL expression over the program's variables\n";
+    return 2;
+  }
+  const st::Application& app = *b.app;
+  const st::ProgramInstance* until = nullptr;
+  for (const auto& o : app.observers)
+    if (st::iequals(o.name, "_PLCFI_UNTIL")) until = &o;
+  const st::Symbol* reached = until ? until->pou->find_var("reached") : nullptr;
+  if (!reached) {
+    std::cerr << "plcfi test: --until: the condition's program is missing\n";
+    return 2;
+  }
+  rt::Schedule sched;
+  if (!tcunit_schedule(app, vm, &sched, "--until scans the program's tasks")) return 2;
+  st::Machine m(app);
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(app, "plcfi test"))) return 2;
+  m.set_native(native.get());
+  rt::UntilOptions uo;
+  uo.timeout_ns = timeout_ns;
+  uo.budget = vm["budget"].as<Count>().value;
+  const rt::UntilReport rep = rt::run_until(app, sched, m, *until, reached->offset, uo);
+  if (!rep.program_trap.empty()) std::cerr << rep.program_trap << "\n";
+  // One group per unit under test, in the order the units first logged.
+  std::vector<rt::AssertLogEntry> log = rep.log;
+  std::vector<std::string> units;
+  for (const auto& e : log)
+    if (std::find(units.begin(), units.end(), e.unit) == units.end()) units.push_back(e.unit);
+  std::stable_sort(log.begin(), log.end(), [&](const auto& x, const auto& y) {
+    return std::find(units.begin(), units.end(), x.unit) < std::find(units.begin(), units.end(), y.unit);
+  });
+  TestTally tally;
+  for (const auto& e : log) {
+    const std::string unit = e.unit.empty() ? "(FB_ASSERT without a name)" : e.unit;
+    const std::string where = e.where.valid() ? app.where(b.sm.origin(e.where)) : "";
+    tally.add(unit, unit, e.passed ? fmt::format("state {}: {}", e.state, e.message) : fmt::format("state {}", e.state),
+              e.passed, where, e.message, 0.0);
+  }
+  if (rep.overflow) std::cout << "  (the log holds 500 entries: later ones were not kept)\n";
+  const std::string ending = rep.reached ? fmt::format("--until held after {} of virtual time ({} cycles)",
+                                                         common::format_duration(rep.virtual_ns), rep.cycles)
+                             : rep.program_trap.empty()
+                                 ? fmt::format("--until did not hold within the time-out ({}, {} cycles)",
+                                               common::format_duration(timeout_ns), rep.cycles)
+                                 : fmt::format("a runtime error ended the run after {} cycles", rep.cycles);
+  std::cout << fmt::format("FB_ASSERT: {} assertions evaluated, {} failed, {} failures logged; {}\n", rep.checks,
+                           rep.failures, tally.failed, ending);
+  if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
+  // Every evaluation counts, also a failure logged once for several cycles of one state.
+  std::cout << rep.checks - rep.failures << " passed, " << rep.failures << " failed\n";
+  if (vm.count("junit")) {
+    std::vector<report::JunitSuite> v;
+    for (const auto& f : tally.order) v.push_back(tally.suites[f]);
+    std::string err;
+    if (!report::write_junit(vm["junit"].as<std::string>(), v, &err)) {
+      std::cerr << "plcfi test: " << err << "\n";
+      return 2;
+    }
+  }
+  return rep.failures > 0 || tally.failed > 0 || !rep.reached ? 1 : 0;
 }
 
 }  // namespace
@@ -326,12 +403,13 @@ int cmd_test(const std::vector<std::string>& args) {
       ("coverage", "print branch coverage of the sources")
       ("budget", po::value<Count>()->default_value(Count{100'000'000}, "100000000"), "loop iterations allowed per test phase (watchdog)")
       ("native", "run the tests through the native tier (generated C++, compiled by the system's compiler)")
-      ("timeout", po::value<std::string>()->default_value("10s"), "TcUnit: virtual time the suites get to finish every test (TcUnit's default: 10s)")
+      ("timeout", po::value<std::string>()->default_value("10s"), "TcUnit: virtual time the suites get to finish every test (TcUnit's default: 10s); --until: the time the condition gets")
       ("program", po::value<std::string>(), "TcUnit: the program to scan (the one calling TcUnit.RUN()) when there is no task configuration or to run it alone")
-      ("cycle-time", po::value<std::string>()->default_value("10ms"), "TcUnit: cycle time of that program");
+      ("cycle-time", po::value<std::string>()->default_value("10ms"), "TcUnit: cycle time of that program")
+      ("until", po::value<std::string>(), "scan the program until this ST condition holds (e.g. 'PRG_TEST.fbTest.bDone'), then report FB_ASSERT's failed assertions");
   po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--timeout 10s]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--timeout 10s] [--until EXPR]")) return 0;
   int64_t timeout_ns = 0;
   std::string err;
   if (!rt::parse_duration(vm["timeout"].as<std::string>(), &timeout_ns, &err) || timeout_ns <= 0) {
@@ -344,15 +422,18 @@ int cmd_test(const std::vector<std::string>& args) {
   opt.warnings = false;
   auto b = load(strings_of(vm, "files"), opt, "test");
   if (!b || !b->ok()) return 2;
+  if (vm.count("until")) return run_until_mode(*b, vm, opt, timeout_ns);
   const st::Application& app = *b->app;
   const bool tcunit = rt::has_tcunit_suites(app);
   if (b->tests.empty() && !tcunit) {
     std::cerr << "plcfi test: no tests among the inputs: neither a test file (it starts with TEST, SETUP or TEARDOWN) "
-                 "nor a TcUnit suite instance (of a function block that EXTENDS FB_TestSuite)\n";
+                 "nor a TcUnit suite instance (of a function block that EXTENDS FB_TestSuite)"
+              << (rt::has_fb_assert(app) ? "; tests with FB_ASSERT run with --until EXPR (e.g. the test FB's bDone)" : "")
+              << "\n";
     return 2;
   }
   rt::Schedule sched;
-  if (tcunit && !tcunit_schedule(app, vm, &sched)) return 2;
+  if (tcunit && !tcunit_schedule(app, vm, &sched, "TcUnit suites run in the scan of the program that calls TcUnit.RUN()")) return 2;
   st::Machine m(app);
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi test"))) return 2;

@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include "common/duration.hpp"
+#include "engine.hpp"
 #include "syntax/source.hpp"
 
 namespace plcfi::rt {
@@ -66,6 +67,21 @@ bool parse_duration(const std::string& text, int64_t* ns, std::string* err) {
   }
   *ns = v;
   return true;
+}
+
+bool Schedule::run_due(const st::Application& app, st::Machine& m, uint64_t n, std::string* trap) const {
+  bool ok = true;
+  for_each_due(n, [&](const ScheduledTask& t) {
+    for (size_t pi : t.programs) {
+      if (!ok) return;
+      const auto& inst = app.programs[pi];
+      if (!m.call(inst.pou->entry, inst.addr)) {
+        ok = false;
+        *trap = st::describe_trap(app, m.trap()) + fmt::format(" (program {}, cycle {})", inst.name, n);
+      }
+    }
+  });
+  return ok;
 }
 
 }  // namespace plcfi::rt

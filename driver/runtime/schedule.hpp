@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "vm/program.hpp"
+#include "vm/vm.hpp"
 
 namespace plcfi::rt {
 
@@ -33,6 +34,9 @@ class Schedule {
     for (const auto& t : tasks_)
       if (n % static_cast<uint64_t>(t.interval_ns / tick_ns_) == 0) f(t);
   }
+  // Calls the programs of the tasks due at base tick n on m, in order, until one traps:
+  // then false, with *trap describing it ("... (program Main, cycle 12)").
+  bool run_due(const st::Application& app, st::Machine& m, uint64_t n, std::string* trap) const;
 
  private:
   void finish();

@@ -157,14 +157,7 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
     }
     m.set_now(now);
     m.clear_taken();
-    schedule.for_each_due(n, [&](const ScheduledTask& t) {
-      for (size_t pi : t.programs) {
-        if (!rep.program_trap.empty()) return;
-        const auto& inst = app.programs[pi];
-        if (!m.call(inst.pou->entry, inst.addr))
-          rep.program_trap = st::describe_trap(app, m.trap()) + fmt::format(" (program {}, cycle {})", inst.name, n);
-      }
-    });
+    schedule.run_due(app, m, n, &rep.program_trap);
     ++n;
     if (!rep.program_trap.empty()) {
       m.merge_coverage();
