@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "import/import.hpp"
+#include "import/ld.hpp"
+#include "import/xml_nodes.hpp"
 
 namespace plcfi::st {
 
@@ -30,32 +32,11 @@ constexpr std::string_view kPlainText = "interfaceasplaintext";
 // reads any depth without recursion; our walk recurses).
 constexpr int kMaxDepth = 64;
 
-std::string_view local_name(const pugi::xml_node& n) {
-  std::string_view name = n.name();
-  size_t colon = name.find(':');
-  return colon == std::string_view::npos ? name : name.substr(colon + 1);
-}
-
-bool is(const pugi::xml_node& n, std::string_view name) { return n.type() == pugi::node_element && local_name(n) == name; }
-
-pugi::xml_node child(const pugi::xml_node& n, std::string_view name) {
-  for (auto c : n.children())
-    if (is(c, name)) return c;
-  return {};
-}
-
-std::vector<pugi::xml_node> children(const pugi::xml_node& n, std::string_view name) {
-  std::vector<pugi::xml_node> out;
-  for (auto c : n.children())
-    if (is(c, name)) out.push_back(c);
-  return out;
-}
-
-pugi::xml_node first_element(const pugi::xml_node& n) {
-  for (auto c : n.children())
-    if (c.type() == pugi::node_element) return c;
-  return {};
-}
+using xml::child;
+using xml::children;
+using xml::first_element;
+using xml::is;
+using xml::local_name;
 
 bool attr_true(const pugi::xml_node& n, const char* name) {
   std::string v = n.attribute(name).value();
@@ -699,6 +680,14 @@ class Importer {
       header(keyword, p, iface, extends);
       var_blocks(iface, what);
     }
+    // A Ladder Diagram body becomes ST (import/ld.hpp); its variables come first.
+    LdTranslation ld;
+    pugi::xml_node ld_body = child(child(p, "body"), "LD");
+    if (ld_body) {
+      LdError err;
+      if (!ld_to_st(ld_body, what, keyword != "FUNCTION", &ld, &err)) return error(err.code.c_str(), err.at, err.message);
+      for (const auto& v : ld.vars) line(v.text, v.at);
+    }
     for (auto data : children(child(p, "addData"), "data")) {
       std::string_view dn = data.attribute("name").value();
       for (auto item : data.children()) {
@@ -709,7 +698,11 @@ class Importer {
       }
     }
     for (auto a : children(child(p, "actions"), "action")) action(a, what);
-    body(p, what);
+    if (ld_body) {
+      for (const auto& st : ld.body) line(st.text, st.at);
+    } else {
+      body(p, what);
+    }
     line("END_" + keyword, p);
     end_unit();
   }

@@ -322,11 +322,53 @@ TEST(PlcopenImport, ErrorInAnAttributeValuePointsAtIt) {
                             "                                                                  ^\n");
 }
 
+// A Ladder Diagram becomes ST: each contact and coil a BOOL of its own (the value at its
+// right side), parallel connections ORed, an edge an R_TRIG instance, in the order of the
+// connections (the coil of the first rung is written after the contacts that feed it,
+// although the XML lists it first).
+TEST(PlcopenImport, LadderDiagramBecomesSt) {
+  XmlFile f(project(R"(<pou name="Rung" pouType="functionBlock">
+  <interface/>
+  <body>
+    <LD>
+      <leftPowerRail localId="1"><connectionPointOut/></leftPowerRail>
+      <coil localId="4" storage="set"><connectionPointIn><connection refLocalId="3"/></connectionPointIn><variable>q</variable></coil>
+      <contact localId="2"><connectionPointIn><connection refLocalId="1"/></connectionPointIn><variable>a</variable></contact>
+      <contact localId="5" edge="rising"><connectionPointIn><connection refLocalId="1"/></connectionPointIn><variable>b</variable></contact>
+      <contact localId="3" negated="true"><connectionPointIn><connection refLocalId="2"/><connection refLocalId="5"/></connectionPointIn><variable>c</variable></contact>
+      <rightPowerRail localId="6"><connectionPointIn><connection refLocalId="4"/></connectionPointIn></rightPowerRail>
+    </LD>
+  </body>
+</pou>
+)"));
+  Imported r = import(f);
+  EXPECT_TRUE(r.ok) << r.diags;
+  EXPECT_EQ(r.text,
+            "---- X.xml(Rung)\n"
+            "FUNCTION_BLOCK Rung\n"
+            "VAR_TEMP\n"
+            "  _ld2 : BOOL;\n"
+            "  _ld5 : BOOL;\n"
+            "  _ld3 : BOOL;\n"
+            "  _ld4 : BOOL;\n"
+            "END_VAR\n"
+            "VAR\n"
+            "  _lde5 : R_TRIG;\n"
+            "END_VAR\n"
+            "_ld2 := TRUE AND a;\n"
+            "_lde5(CLK := b);\n"
+            "_ld5 := TRUE AND _lde5.Q;\n"
+            "_ld3 := (_ld2 OR _ld5) AND NOT c;\n"
+            "_ld4 := _ld3;\n"
+            "IF _ld4 THEN q := TRUE; END_IF;\n"
+            "END_FUNCTION_BLOCK\n");
+}
+
 TEST(PlcopenImport, GraphicalBodyIsOneErrorAtTheBody) {
   XmlFile f(project(R"(<pou name="Conveyor" pouType="program">
   <interface/>
   <body>
-    <LD><leftPowerRail localId="1"/></LD>
+    <FBD><inVariable localId="1"/></FBD>
   </body>
 </pou>
 <pou name="Uses" pouType="program">
@@ -334,7 +376,7 @@ TEST(PlcopenImport, GraphicalBodyIsOneErrorAtTheBody) {
 </pou>
 )"));
   bool ok = true;
-  EXPECT_EQ(build_diags(f, &ok), "X.xml:6:3: error[ST604]: POU 'Conveyor' has an LD body: plcfi runs ST bodies only\n"
+  EXPECT_EQ(build_diags(f, &ok), "X.xml:6:3: error[ST604]: POU 'Conveyor' has an FBD body: plcfi runs ST bodies only\n"
                                  "    <body>\n"
                                  "    ^\n");
   EXPECT_FALSE(ok);

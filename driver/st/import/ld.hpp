@@ -1,0 +1,44 @@
+// Ladder Diagram bodies of PLCopen XML (TC6 2.01 <LD>) translated to ST, so a project with
+// an LD POU runs like one written in ST. The network is a graph: every element names the
+// elements its input is connected to (connectionPointIn/connection refLocalId); several
+// connections into one input are a parallel branch (OR). Elements are evaluated in an
+// order that respects the connections, ties kept in document order (the rungs top to
+// bottom); a loop in the graph is an error.
+//
+// Supported: left and right power rails; contacts (normally open, negated, rising and
+// falling edge); coils (plain, negated, set, reset, rising and falling edge); function and
+// function block calls (<block>, with EN/ENO); input, output and in-out variables;
+// connectors and continuations; comments. Anything else (jumps, labels, returns) is an
+// error naming the element.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <pugixml.hpp>
+
+namespace plcfi::st {
+
+// One line of generated ST and the element it came from (for diagnostics).
+struct LdLine {
+  std::string text;
+  pugi::xml_node at;
+};
+
+struct LdTranslation {
+  std::vector<LdLine> vars;  // declaration blocks the body needs (before the body)
+  std::vector<LdLine> body;  // the statements
+};
+
+struct LdError {
+  std::string code;
+  pugi::xml_node at;
+  std::string message;
+};
+
+// Translates the <LD> element `ld` of `what` (e.g. "POU 'Conveyor'"). `instances`: the
+// POU may hold FB instances (edges need R_TRIG/F_TRIG); false for a FUNCTION. False, with
+// *err, at the first element that cannot be translated.
+bool ld_to_st(const pugi::xml_node& ld, const std::string& what, bool instances, LdTranslation* out, LdError* err);
+
+}  // namespace plcfi::st
