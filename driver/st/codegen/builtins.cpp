@@ -277,6 +277,13 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
     from = v.type ? v.type : default_type(v.c);
   }
   Slot s = to_slot(v, from, args[0]->loc);
+  if (conv.unit_ns) {  // TIME_TO_US: durations are held in nanoseconds
+    if (conv.unit_ns == 1) return slot_val(to, s);
+    Slot d = temp(8, 8);
+    emit(num_op(Op::DIV_I8, Storage::I64), {d, s, konst_i64(conv.unit_ns)});
+    def(d);
+    return slot_val(to, d);
+  }
   if (conv.bcd != ConversionName::Bcd::None) {
     bool decode = conv.bcd == ConversionName::Bcd::Decode;
     if (decode ? !from->is_bitstring() : !from->is_integer()) {

@@ -221,6 +221,15 @@ std::optional<ConversionName> parse_conversion(const TypeTable& tt, std::string_
   } else if (at != std::string_view::npos) {
     from_name = upper_name.substr(0, at);
     to_name = upper_name.substr(at + 4);
+    static constexpr std::pair<std::string_view, int64_t> kUnits[] = {
+        {"NS", 1}, {"US", 1'000}, {"MS", 1'000'000}, {"S", 1'000'000'000}};
+    for (auto [unit, ns] : kUnits)
+      if (to_name == unit && (from_name == "TIME" || from_name == "LTIME")) {
+        out.from = tt.by_name(from_name);
+        out.to = tt.elementary(TypeKind::LInt);
+        out.unit_ns = ns;
+        return out;
+      }
   } else if (upper_name.rfind("TO_", 0) == 0) {
     to_name = upper_name.substr(3);
   } else if (upper_name == "TRUNC") {

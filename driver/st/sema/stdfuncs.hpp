@@ -94,6 +94,9 @@ struct ConversionName {
   // BCD: WORD_BCD_TO_UINT, BCD_TO_INT (decode the bit string's nibbles as decimal digits),
   // UINT_TO_BCD_WORD, INT_TO_BCD, TO_BCD_WORD (encode).
   enum class Bcd : uint8_t { None, Decode, Encode } bcd = Bcd::None;
+  // TIME_TO_US, LTIME_TO_S, ...: a duration as a LINT count of this many nanoseconds
+  // (NS 1, US 1000, MS 10^6, S 10^9), truncated toward zero; 0: not such a conversion.
+  int64_t unit_ns = 0;
 };
 // Null when the name is no conversion (or names a type that does not exist).
 std::optional<ConversionName> parse_conversion(const TypeTable& tt, std::string_view upper_name);
