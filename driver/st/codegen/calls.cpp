@@ -91,9 +91,15 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
     if (it != pous_.end()) {
       PouInfo* p = it->second;
       if (p->kind == PouKind::Function) return call_function(p, c);
+      if (p->kind == PouKind::Program && opt_.dialect == Dialect::Codesys) {  // MAIN(); its one instance
+        Place inst = program_place(p, callee.loc);
+        if (!inst.ok) return bad();
+        return call_fb(inst, p, c);
+      }
       diags_.error("ST213", callee.loc, "'" + n.name.text + "' is a " +
                                             (p->kind == PouKind::FunctionBlock ? std::string("function block type: declare an instance and call that") :
-                                             p->kind == PouKind::Program ? std::string("PROGRAM type: it runs from a task, or declare an instance in a test") :
+                                             p->kind == PouKind::Program ? std::string("PROGRAM type: it runs from a task, or declare an instance in a test "
+                                                                                     "(calling a program by its name is CODESYS: --dialect codesys)") :
                                                                             std::string("interface")));
       return bad();
     }

@@ -789,8 +789,20 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
   }
   for (auto& pi : app_->programs) {
     if (!pi.pou->compiled) continue;
-    pi.addr = alloc(pi.pou->frame_size, 8);
-    std::copy(pi.pou->type->init.begin(), pi.pou->type->init.end(), app_->init_image.begin() + pi.addr);
+    // A PROGRAM other POUs name (MAIN.n) has its memory already: its one instance takes it.
+    if (auto named = program_addr_.find(pi.pou); named != program_addr_.end()) {
+      const auto copies = std::count_if(app_->programs.begin(), app_->programs.end(),
+                                        [&](const ProgramInstance& o) { return o.pou == pi.pou; });
+      if (copies > 1 && &pi == &*std::find_if(app_->programs.begin(), app_->programs.end(),
+                                               [&](const ProgramInstance& o) { return o.pou == pi.pou; })) {
+        diags_.error("ST223", named->second.second, pi.pou->name + " has " + std::to_string(copies) +
+                                                        " instances in the configuration: which one this names is ambiguous");
+      }
+      pi.addr = named->second.first;
+    } else {
+      pi.addr = alloc(pi.pou->frame_size, 8);
+      std::copy(pi.pou->type->init.begin(), pi.pou->type->init.end(), app_->init_image.begin() + pi.addr);
+    }
     for (const auto& v : pi.pou->vars)
       if (v->retain && v->where == Where::Frame) app_->retain_ranges.emplace_back(pi.addr + v->offset, v->type->size);
   }

@@ -304,6 +304,9 @@ class Compiler {
     return p;
   }
   Place this_place(SourceLoc loc);
+  Place program_place(PouInfo* p, SourceLoc loc);
+  // PROGRAMs named from other POUs: their instance's address, and where first named.
+  std::unordered_map<const PouInfo*, std::pair<uint32_t, SourceLoc>> program_addr_;
   Place symbol_place(const Symbol* s, SourceLoc loc);
   Place member_place(Place base, const Ident& member, SourceLoc loc);
   Place index_place(Place base, const IndexExpr& e);

@@ -1,5 +1,7 @@
 // Places (lvalues): name lookup, variables, members, array elements, dereferences,
 // THIS; loading from and storing to them, assignment and ADR.
+#include <algorithm>
+
 #include "compiler_impl.hpp"
 
 namespace plcfi::st::detail {
@@ -63,6 +65,36 @@ Place Compiler::symbol_place(const Symbol* s, SourceLoc loc) {
   }
   (void)loc;
   return p;
+}
+
+// A PROGRAM named from another POU (CODESYS: MAIN.n, MAIN.A_Init()): its one instance,
+// laid out here when first named; the configuration's instance of it takes that memory
+// (run()).
+Place Compiler::program_place(PouInfo* p, SourceLoc loc) {
+  Place bad;
+  bad.ok = false;
+  if (b_ && b_->pou == p) {
+    diags_.error("ST223", loc, "inside " + p->name + ", name its variables without '" + p->name + ".'");
+    return bad;
+  }
+  if (std::find(compiling_.begin(), compiling_.end(), p) != compiling_.end()) {
+    diags_.error("ST223", loc, p->name + " and the POU that names it here name each other: one of them must reach the "
+                                        "other's variables through a global variable");
+    return bad;
+  }
+  ensure_compiled(p, loc);
+  if (!p->compiled) return bad;
+  auto it = program_addr_.find(p);
+  if (it == program_addr_.end()) {
+    const uint32_t addr = alloc(p->frame_size, 8);
+    std::copy(p->type->init.begin(), p->type->init.end(), app_->init_image.begin() + addr);
+    it = program_addr_.emplace(p, std::make_pair(addr, loc)).first;
+  }
+  Place pl;
+  pl.k = Place::K::Abs;
+  pl.off = it->second.first;
+  pl.type = p->type;
+  return pl;
 }
 
 Place Compiler::this_place(SourceLoc loc) {
@@ -146,8 +178,13 @@ Place Compiler::place_ref(const Expr& e, bool for_write) {
         diags_.error("ST206", e.loc, "'" + n.name.text + "' is an enumeration value, not a variable");
         return bad_place;
       }
-      if (pous_.count(key)) {
-        diags_.error("ST223", e.loc, "'" + n.name.text + "' is a POU, not a variable");
+      if (auto it = pous_.find(key); it != pous_.end()) {
+        if (it->second->kind == PouKind::Program && opt_.dialect == Dialect::Codesys) return program_place(it->second, e.loc);
+        diags_.error("ST223", e.loc, "'" + n.name.text + "' is a POU, not a variable" +
+                                         (it->second->kind == PouKind::Program
+                                              ? std::string(" (a program's variables by its name, ") + n.name.text +
+                                                    ".x, are CODESYS: --dialect codesys)"
+                                              : std::string()));
         return bad_place;
       }
       diags_.error("ST200", e.loc, "unknown identifier '" + n.name.text + "'");
