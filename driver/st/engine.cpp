@@ -60,8 +60,42 @@ bool uses_library(const SourceManager& sm, const std::vector<uint32_t>& files, c
   return named;
 }
 
+// Where `word` stands in text as a whole identifier (any case), from `from`; npos if not.
+size_t find_word(const std::string& text, std::string_view word, size_t from = 0) {
+  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (size_t at = from; at + word.size() <= text.size(); ++at) {
+    if (!iequals(std::string_view(text).substr(at, word.size()), word)) continue;
+    if ((at > 0 && ident(text[at - 1])) || (at + word.size() < text.size() && ident(text[at + word.size()]))) continue;
+    return at;
+  }
+  return std::string::npos;
+}
+
+// The Tc2 data types the sources name and do not declare (a name followed by ':' but not
+// ':='), as one library text; empty when there are none.
+std::string tc2_library(const SourceManager& sm, const std::vector<uint32_t>& files) {
+  std::string text;
+  for (const Tc2Type& t : tc2_types()) {
+    bool named = false, declared = false;
+    for (uint32_t f : files) {
+      if (is_library_path(sm.file(f).path)) continue;
+      const std::string& src = sm.file(f).text;
+      for (size_t at = find_word(src, t.name); at != std::string::npos; at = find_word(src, t.name, at + 1)) {
+        named = true;
+        size_t k = at + std::strlen(t.name);
+        while (k < src.size() && std::isspace(static_cast<unsigned char>(src[k]))) ++k;
+        if (k < src.size() && src[k] == ':' && (k + 1 >= src.size() || src[k + 1] != '=')) declared = true;
+      }
+    }
+    if (named && !declared) text += t.source;
+  }
+  return text;
+}
+
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> files, const CompileOptions& opt,
                               const GeneratedSources& late, const std::set<uint32_t>& imported = {}) {
+  if (opt.dialect == Dialect::Codesys)
+    if (std::string tc2 = tc2_library(b->sm, files); !tc2.empty()) files.insert(files.begin() + 1, b->sm.add("<Tc2>", tc2));
   if (uses_library(b->sm, files, "fb_testsuite")) files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
   if (uses_library(b->sm, files, "fb_assert")) files.insert(files.begin() + 1, b->sm.add("<FB_ASSERT>", fb_assert_source()));
   for (uint32_t f : files) {

@@ -53,12 +53,19 @@ const char* tcunit_source();
 // FB_ASSERT (the assertion-FB style of TwinCAT unit tests), compiled with an application
 // whose sources use it (stdlib/tcunit.cpp).
 const char* fb_assert_source();
+// A data type of Beckhoff's Tc2 libraries (T_MaxString, TIMESTRUCT, ...) and its ST
+// declaration (stdlib/tc2.cpp).
+struct Tc2Type {
+  const char* name;
+  const char* source;
+};
+const std::vector<Tc2Type>& tc2_types();
 // The location a TcUnit assertion's hidden input _tcuAt holds (codegen/tcunit.cpp).
 SourceLoc unpack_location(int64_t packed);
 // The libraries plcfi brings, loaded under these names: no warnings, mocks, coverage or
 // listing of their own. (Other sources in memory have names in angle brackets too.)
 inline bool is_library_path(const std::string& path) {
-  return path == "<stdlib>" || path == "<TcUnit>" || path == "<FB_ASSERT>";
+  return path == "<stdlib>" || path == "<TcUnit>" || path == "<FB_ASSERT>" || path == "<Tc2>";
 }
 
 }  // namespace plcfi::st

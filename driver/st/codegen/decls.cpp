@@ -157,7 +157,12 @@ const Type* Compiler::named_type(const Ident& name, uint32_t file, bool report) 
     if (report) diags_.error("ST201", name.loc, "'" + name.text + "' is a function, not a type");
     return nullptr;
   }
-  if (report) diags_.error("ST201", name.loc, "unknown type '" + name.text + "'");
+  if (report) {
+    const auto& tc2 = tc2_types();
+    const bool is_tc2 = std::any_of(tc2.begin(), tc2.end(), [&](const Tc2Type& t) { return iequals(t.name, name.text); });
+    diags_.error("ST201", name.loc, "unknown type '" + name.text + "'" +
+                                        (is_tc2 && opt_.dialect == Dialect::Iec ? " (a type of TwinCAT's Tc2 libraries: --dialect codesys)" : ""));
+  }
   return nullptr;
 }
 
