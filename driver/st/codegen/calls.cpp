@@ -103,13 +103,12 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
                                                                             std::string("interface")));
       return bad();
     }
-    if (key == "__NEW" || key == "__DELETE" || key == "__QUERYINTERFACE" || key == "__QUERYPOINTER") {
+    if (key == "__NEW" || key == "__DELETE") {
       diags_.error("ST235", callee.loc,
-                   n.name.text + (key == "__NEW" || key == "__DELETE"
-                                      ? " (dynamic memory) is CODESYS that plcfi does not run: declare the instance as a variable"
-                                      : " is CODESYS that plcfi does not run yet: call the methods through a variable of the interface"));
+                   n.name.text + " (dynamic memory) is CODESYS that plcfi does not run: declare the instance as a variable");
       return bad();
     }
+    if (key == "__QUERYINTERFACE" || key == "__QUERYPOINTER") return query_interface(c, key == "__QUERYPOINTER");
     if (auto b = builtin(key, c)) return *b;
     // A method of this instance called by its bare name.
     if (b_->this_type && b_->this_type->pou) {
@@ -620,6 +619,81 @@ void Compiler::property_set(PouInfo* setter, Slot this_ptr, const Val& v, Source
   assign(field, v, loc);
   mark(loc);
   emit(Op::CALLV, {frame, this_ptr, setter->selector});
+}
+
+// __QUERYINTERFACE(itfSource, itfDest) (CODESYS): itfDest := the instance behind
+// itfSource when its FB implements itfDest's interface, else 0; TRUE when it does.
+// __QUERYPOINTER(itfSource, pDest): pDest := the instance's address; TRUE when not 0.
+// An interface value is the instance's address; the instance starts with its type's id.
+Val Compiler::query_interface(const CallExpr& c, bool pointer) {
+  const std::string name = pointer ? "__QUERYPOINTER" : "__QUERYINTERFACE";
+  auto args = positional(c, 2, 2, name);
+  if (args.size() != 2) return bad();
+  if (opt_.dialect == Dialect::Iec) {
+    diags_.error("ST241", c.loc, name + " is CODESYS, not IEC 61131-3: use --dialect codesys");
+    return bad();
+  }
+  Val src = expr(*args[0], nullptr);
+  if (!src.ok) return bad();
+  if (!src.type || src.type->kind != TypeKind::Interface) {
+    diags_.error("ST203", args[0]->loc, name + " needs an interface variable first, not " +
+                                            (src.type ? src.type->name : std::string("a literal")));
+    return bad();
+  }
+  Place dst = place(*args[1], true);
+  if (!dst.ok) return bad();
+  if (pointer ? dst.type->kind != TypeKind::Ref : dst.type->kind != TypeKind::Interface) {
+    diags_.error("ST203", args[1]->loc, name + (pointer ? " writes the instance's address into a POINTER or REFERENCE, not "
+                                                        : " writes into a variable of an interface, not ") + dst.type->name);
+    return bad();
+  }
+  const Type* udint = elem(TypeKind::UDInt);
+  const Type* boolean = elem(TypeKind::Bool);
+  Slot addr = to_slot(src, src.type, args[0]->loc);
+  Val addr_val;
+  addr_val.type = udint;
+  addr_val.slot = addr;
+  auto konst_of = [&](const Type* t, ConstV::K k, int64_t i) {
+    Val v;
+    v.type = t;
+    v.is_const = true;
+    v.c.k = k;
+    v.c.i = i;
+    return v;
+  };
+  Slot result = temp(1, 1);
+  Place result_place = frame_place(result, boolean);
+  Val null_val = konst_of(udint, ConstV::K::Int, 0);
+  Val as_dst = addr_val;
+  as_dst.type = dst.type;
+  Place dst_word = dst;
+  dst_word.type = udint;
+  if (pointer) {  // the address itself, whatever the instance
+    store(dst_word, addr);
+    assign(result_place, combine(BinaryOp::Ne, addr_val, null_val, c.loc), c.loc);
+    return load(result_place);
+  }
+  assign(result_place, konst_of(boolean, ConstV::K::Bool, 0), c.loc);
+  assign(dst_word, null_val, c.loc);
+  Label done = new_label();
+  branch_on(combine(BinaryOp::Ne, addr_val, null_val, c.loc), c.loc, done, false);
+  Place header;
+  header.k = Place::K::Ind;
+  header.ptr = addr;
+  header.type = elem(TypeKind::UInt);
+  Val type_id = load(header);
+  for (const auto& p : app_->pous) {
+    if (!p->type_id || p->kind != PouKind::FunctionBlock || !implements(p.get(), dst.type->pou)) continue;
+    Label next = new_label();
+    branch_on(combine(BinaryOp::Eq, type_id, konst_of(elem(TypeKind::UInt), ConstV::K::Int, p->type_id), c.loc), c.loc,
+              next, false);
+    store(dst_word, addr);
+    assign(result_place, konst_of(boolean, ConstV::K::Bool, 1), c.loc);
+    emit(Op::JMP, {Arg::target(done.id)});
+    bind(next);
+  }
+  bind(done);
+  return load(result_place);
 }
 
 }  // namespace plcfi::st::detail

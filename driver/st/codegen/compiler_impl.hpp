@@ -323,6 +323,7 @@ class Compiler {
   Val call_function(PouInfo* f, const CallExpr& c);
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
+  Val query_interface(const CallExpr& c, bool pointer);  // __QUERYINTERFACE, __QUERYPOINTER
   // A value the compiler passes for a parameter (FB_init's bInitRetains and bInCopyCode):
   // no argument may name it, and positional arguments start after it.
   struct FixedArg {
