@@ -222,6 +222,7 @@ class Compiler {
   // The dialect's implicit conversions (see CompileOptions::dialect).
   bool dialect_converts(const Type* from, const Type* to) const;
   Val implicit_conversion(const Val& v, const Type* to, SourceLoc loc, const char* what);
+  std::optional<Val> pointer_conversion(const Val& v, const Type* to, SourceLoc loc);
   const Type* dialect_common_type(const Type* a, const Type* b) const;
   // Whether some FB extends `fb`: then an instance reached through a reference or a
   // VAR_IN_OUT may be of a derived type, and its methods dispatch at run time.

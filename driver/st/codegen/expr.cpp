@@ -145,7 +145,10 @@ Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* wh
     out.type = to;
     return out;
   }
-  if (opt_.dialect == Dialect::Codesys && dialect_converts(v.type, to)) return implicit_conversion(v, to, loc, what);
+  if (opt_.dialect == Dialect::Codesys) {
+    if (std::optional<Val> p = pointer_conversion(v, to, loc)) return *p;
+    if (dialect_converts(v.type, to)) return implicit_conversion(v, to, loc, what);
+  }
   std::string hint;
   if (v.type->is_elementary() && to->is_elementary() && v.type->kind != TypeKind::Enum && to->kind != TypeKind::Enum &&
       v.type->kind != TypeKind::Ref && to->kind != TypeKind::Ref)
@@ -153,6 +156,34 @@ Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* wh
   diags_.error("ST203", loc, "cannot convert " + v.type->name + " to " + to->name + " implicitly" +
                                  (what ? std::string(" in ") + what : "") + hint);
   return bad();
+}
+
+// CODESYS pointers: a POINTER TO (or REF_TO) one type is taken for one to any other (as
+// `pt := ADR(buffer)` does), and an address converts to and from an integer or bit string
+// (DWORD, UDINT, LWORD, ...). Addresses are 32-bit numbers here. Nullopt: not such a case.
+std::optional<Val> Compiler::pointer_conversion(const Val& v, const Type* to, SourceLoc loc) {
+  const Type* udint = elem(TypeKind::UDInt);
+  const bool from_ref = v.type->kind == TypeKind::Ref && !v.type->implicit_deref;
+  const bool to_ref = to->kind == TypeKind::Ref && !to->implicit_deref;
+  auto address_number = [](const Type* t) { return t->is_integer() || t->is_bitstring(); };
+  if (from_ref && to_ref) {
+    Val out = v;
+    out.type = to;
+    return out;
+  }
+  if (from_ref && address_number(to)) {
+    Val out;
+    out.type = to;
+    out.slot = convert(to_slot(v, v.type, loc), udint, to);
+    return out;
+  }
+  if (to_ref && address_number(v.type)) {
+    Val out;
+    out.type = to;
+    out.slot = convert(to_slot(v, v.type, loc), v.type, udint);
+    return out;
+  }
+  return std::nullopt;
 }
 
 // CODESYS and TwinCAT convert between any two numbers, bit strings and BOOL implicitly.
@@ -708,6 +739,19 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     return v;
   }
 
+  // CODESYS pointer arithmetic: a POINTER plus or minus a number of bytes is a POINTER.
+  if (opt_.dialect == Dialect::Codesys && (e.op == BinaryOp::Add || e.op == BinaryOp::Sub)) {
+    auto pointer = [&](const Type* t) { return t && t->kind == TypeKind::Ref && !t->implicit_deref; };
+    auto number = [&](const Val& v) { return v.type ? v.type->is_integer() || v.type->is_bitstring() : v.c.k == ConstV::K::Int; };
+    const bool left = pointer(lt) && number(r), right = e.op == BinaryOp::Add && pointer(rt) && number(l);
+    if (left || right) {
+      const Type* udint = elem(TypeKind::UDInt);
+      Val p = left ? l : r, n = left ? r : l;
+      p.type = udint;  // the address, as the number it is
+      Slot a = operand(p, udint), b = operand(n, udint);
+      return emit_bin(e.op == BinaryOp::Add ? Op::ADD_I8 : Op::SUB_I8, udint, a, b, left ? lt : rt);
+    }
+  }
   // References and interfaces: equality only.
   if (lt->kind == TypeKind::Ref || rt->kind == TypeKind::Ref || lt->kind == TypeKind::Interface || rt->kind == TypeKind::Interface ||
       lt == null_type_ || rt == null_type_) {
