@@ -170,8 +170,14 @@ class Translator {
     else if (e.kind == "contact" || e.kind == "coil") *v = "_ld" + std::to_string(id);
     else if (e.kind == "inVariable" || e.kind == "inOutVariable") *v = "(" + expression(e) + ")";
     else if (e.kind == "continuation") {
-      const Element& c = elements_[by_id_.at(connectors_.at(trimmed(e.n.attribute("name").value())))];
-      return input(c, c.inputs.empty() ? Input{} : c.inputs.front(), v);
+      auto named = connectors_.find(trimmed(e.n.attribute("name").value()));
+      if (named == connectors_.end())
+        return fail(e.n, "<continuation name=\"" + trimmed(e.n.attribute("name").value()) + "\"> has no <connector> of that name");
+      if (++depth_ > kMaxDepth) return fail(e.n, "connectors and continuations chained too deep");
+      const Element& c = elements_[by_id_.at(named->second)];
+      const bool ok = input(c, c.inputs.empty() ? Input{} : c.inputs.front(), v);
+      --depth_;
+      return ok;
     } else if (e.kind == "block") {
       auto it = block_out_.find(id);
       if (it == block_out_.end()) return fail(user, "is connected to a block that gives no value");
@@ -201,6 +207,9 @@ class Translator {
       *v += ")";
     }
     if (in.negated) *v = "NOT " + *v;
+    // Function boxes are written where their value is used: a value used twice at every
+    // level doubles at every level.
+    if (v->size() > kMaxText) return fail(e.n, "the expression this input stands for is too large (function boxes nest too deep)");
     return true;
   }
 
@@ -303,6 +312,9 @@ class Translator {
     return true;
   }
 
+  static constexpr int kMaxDepth = 256;
+  static constexpr size_t kMaxText = 64 * 1024;
+  int depth_ = 0;
   std::string what_;
   bool instances_;
   LdTranslation* out_;

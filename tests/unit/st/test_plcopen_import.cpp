@@ -364,6 +364,36 @@ TEST(PlcopenImport, LadderDiagramBecomesSt) {
             "END_FUNCTION_BLOCK\n");
 }
 
+// A continuation without its connector, and function boxes whose value is used twice at
+// every level (the ST written for it would double at every level): errors, not a crash
+// or a run out of memory.
+TEST(PlcopenImport, LadderDiagramLimits) {
+  XmlFile orphan(project(R"(<pou name="Orphan" pouType="functionBlock">
+  <interface/>
+  <body><LD>
+    <continuation localId="1" name="nowhere"><connectionPointOut/></continuation>
+    <coil localId="2"><connectionPointIn><connection refLocalId="1"/></connectionPointIn><variable>q</variable></coil>
+  </LD></body>
+</pou>
+)"));
+  Imported r = import(orphan);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.diags.find("<continuation name=\"nowhere\"> has no <connector> of that name"), std::string::npos) << r.diags;
+
+  std::string boxes = "<inVariable localId=\"1\"><connectionPointOut/><expression>x</expression></inVariable>\n";
+  for (int k = 2; k <= 40; ++k)
+    boxes += "<block localId=\"" + std::to_string(k) + "\" typeName=\"ADD\"><inputVariables>"
+             "<variable formalParameter=\"IN1\"><connectionPointIn><connection refLocalId=\"" + std::to_string(k - 1) +
+             "\"/></connectionPointIn></variable><variable formalParameter=\"IN2\"><connectionPointIn><connection refLocalId=\"" +
+             std::to_string(k - 1) + "\"/></connectionPointIn></variable></inputVariables>"
+             "<outputVariables><variable formalParameter=\"OUT\"><connectionPointOut/></variable></outputVariables></block>\n";
+  XmlFile doubling(project("<pou name=\"Doubling\" pouType=\"functionBlock\">\n<interface/>\n<body><LD>\n" + boxes +
+                           "</LD></body>\n</pou>\n"));
+  r = import(doubling);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.diags.find("function boxes nest too deep"), std::string::npos) << r.diags;
+}
+
 TEST(PlcopenImport, GraphicalBodyIsOneErrorAtTheBody) {
   XmlFile f(project(R"(<pou name="Conveyor" pouType="program">
   <interface/>
