@@ -664,8 +664,6 @@ Val Compiler::query_interface(const CallExpr& c, bool pointer) {
   Slot result = temp(1, 1);
   Place result_place = frame_place(result, boolean);
   Val null_val = konst_of(udint, ConstV::K::Int, 0);
-  Val as_dst = addr_val;
-  as_dst.type = dst.type;
   Place dst_word = dst;
   dst_word.type = udint;
   if (pointer) {  // the address itself, whatever the instance
