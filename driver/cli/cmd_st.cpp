@@ -333,6 +333,14 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
     std::cerr << "plcfi test: --until '" << expr << "' is not a BOOL expression over the program's variables\n";
     return 2;
   }
+  // One expression: text that closes the assignment and goes on (`X; END_PROGRAM ...`)
+  // would compile as statements or POUs of its own.
+  const st::CompilationUnit& cond = *b.late.back();
+  if (cond.pous.size() != 1 || cond.pous[0]->body.size() != 1 || !cond.types.empty() || !cond.globals.empty() ||
+      !cond.configs.empty()) {
+    std::cerr << "plcfi test: --until '" << expr << "' is not one expression: give a single BOOL condition\n";
+    return 2;
+  }
   const st::Application& app = *b.app;
   const st::ProgramInstance* until = nullptr;
   for (const auto& o : app.observers)
