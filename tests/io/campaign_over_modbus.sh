@@ -47,7 +47,10 @@ test $status -eq 2
 grep -q "refusing to inject faults on real I/O" "$work"/refused.txt
 
 echo "== over Modbus TCP, in real time"
-"$plcfi" plant-server --listen 127.0.0.1:$port > "$work"/server.log 2>&1 &
+# The operator holds start for a second (operator_long_press.yaml): a 0.2 s press can fall
+# unseen into a gap of a loaded machine (a late plant server, a reconnect).
+"$plcfi" plant-server --listen 127.0.0.1:$port --plant-config "$src"/tests/io/operator_long_press.yaml \
+  > "$work"/server.log 2>&1 &
 server=$!
 for _ in $(seq 1 200); do grep -q listening "$work"/server.log && break; sleep 0.05; done
 "$plcfi" campaign "$work"/bench.yaml --arm --out "$work"/bench --quiet --no-vcd > "$work"/bench.txt || test $? -eq 1
