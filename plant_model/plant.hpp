@@ -27,6 +27,7 @@ struct SignalInfo {
   SignalKind kind;
   std::string address;      // default image binding, e.g. "%IX0.4", "%QW2"
   std::string description;  // one line for humans (reports, --help)
+  std::string where = {};   // where the binding was written (a plant file's FILE:LINE:COL), or ""
 };
 
 // Contract: single-threaded. reset() before the first step(). step() must not allocate
@@ -52,6 +53,12 @@ class Plant {
 
   // Counters for summaries: e.g. {"workpieces_stamped", 12}, {"workpieces_defective", 0}.
   virtual std::vector<std::pair<std::string, double>> stats() const = 0;
+
+  // Where the plant comes from, for reports: "" for a built-in plant named by --plant,
+  // else the plant file and what it loads ("tank.yaml (FMU tank.fmu, FMI 2.0 co-simulation)").
+  virtual std::string origin() const { return ""; }
+  // The plant's own step in ns; 0: it steps with every scan, by the scan's tick.
+  virtual int64_t step_ns() const { return 0; }
 };
 
 // Creates a plant by name ("stamping"); config_path may be empty (defaults). Returns null

@@ -15,6 +15,7 @@
 
 #include "common/file.hpp"
 #include "common/hash.hpp"
+#include "io/sim/plant_factory.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "journal.hpp"
 #include "plant_model/plant.hpp"
@@ -442,7 +443,7 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
 }
 
 bool run_campaign(CampaignBuild& cb, const DriverOptions& opt, CampaignResult* out, std::string* err) {
-  auto plant = plant::make_plant(cb.spec.plant, cb.spec.plant_config, err);
+  auto plant = io::open_plant(cb.spec.plant, cb.spec.plant_config, err);
   if (!plant) {
     *err = cb.spec.path + ": plant: " + *err;
     return false;

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "campaign/spec_internal.hpp"
+#include "plant_model/plant_file.hpp"
 
 namespace plcfi::campaign {
 
@@ -32,6 +33,8 @@ void parse_campaign(const common::YamlDoc& f, Campaign* c) {
   }
   if (f.root()["dialect"]) c->dialect = f.word(f.root()["dialect"], "dialect", {"iec", "codesys"});
   c->plant = f.scalar(f.required(f.root(), "plant", "a campaign file"), "plant");
+  // A plant file (tank.yaml) is found relative to the campaign file; a built-in plant by name.
+  if (plant::is_plant_file(c->plant)) c->plant = relative_to(f.path(), c->plant);
   if (f.root()["plant_config"]) c->plant_config = relative_to(f.path(), f.scalar(f.root()["plant_config"], "plant_config"));
   if (f.root()["cycle"]) c->cycle_ns = f.duration(f.root()["cycle"], "cycle", 1);
   if (f.root()["seed"]) c->seed = static_cast<uint64_t>(f.integer(f.root()["seed"], "seed", 0));

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "options.hpp"
 #include "engine.hpp"
+#include "io/sim/plant_factory.hpp"
 #include "plant_model/plant.hpp"
 #include "report/junit.hpp"
 #include "runtime/clock.hpp"
@@ -175,7 +176,7 @@ int cmd_plant_server(const std::vector<std::string>& args) {
     std::cerr << "plcfi plant-server: --stall: " << (err.empty() ? "at most 10 s" : err) << "\n";
     return 2;
   }
-  auto plant = plant::make_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
+  auto plant = io::open_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
   if (!plant) {
     std::cerr << "plcfi plant-server: " << err << "\n";
     return 2;

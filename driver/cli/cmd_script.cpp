@@ -14,6 +14,7 @@
 #include "io/bench/bench_io.hpp"
 #include "io/io_config.hpp"
 #include "io/link_fault.hpp"
+#include "io/sim/plant_factory.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "options.hpp"
 #include "plant_model/plant.hpp"
@@ -223,7 +224,7 @@ int cmd_script(const std::vector<std::string>& args) {
     backend = bench_io.get();
     where = "bench I/O " + cfg.path;
   } else {
-    auto plant = plant::make_plant(vm.count("plant") ? vm["plant"].as<std::string>() : "stamping",
+    auto plant = io::open_plant(vm.count("plant") ? vm["plant"].as<std::string>() : "stamping",
                                    vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
     if (!plant) {
       std::cerr << "plcfi script: " << err << "\n";

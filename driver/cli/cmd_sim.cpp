@@ -8,7 +8,9 @@
 #include "commands.hpp"
 #include "options.hpp"
 #include "trace_hook.hpp"
+#include "common/duration.hpp"
 #include "engine.hpp"
+#include "io/sim/plant_factory.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "monitor/edtl.hpp"
 #include "plant_model/plant.hpp"
@@ -168,7 +170,7 @@ int cmd_sim(const std::vector<std::string>& args) {
     std::cerr << "plcfi sim: " << err << "\n";
     return 2;
   }
-  auto plant = plant::make_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
+  auto plant = io::open_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
   if (!plant) {
     std::cerr << "plcfi sim: " << err << "\n";
     return 2;
@@ -277,6 +279,15 @@ int cmd_sim(const std::vector<std::string>& args) {
   double simulated = static_cast<double>(runtime.now()) * 1e-9;
   std::cout << fmt::format("plcfi sim: {} on plant {} (seed {}), base tick {} ms\n", files.back(), backend->plant().name(), seed,
                            static_cast<double>(sched.tick_ns()) / 1e6);
+  if (const std::string origin = backend->plant().origin(); !origin.empty()) {
+    const int64_t step = backend->plant().step_ns();
+    std::cout << fmt::format("  plant file      {}{}\n", origin,
+                             step > 0 ? fmt::format(", plant step {}", common::format_duration(step)) : "");
+    if (step > sched.tick_ns())
+      std::cout << fmt::format("  note            the plant step is coarser than the base tick: the plant's outputs "
+                               "change at most every {} scans\n",
+                               (step + sched.tick_ns() - 1) / sched.tick_ns());
+  }
   std::cout << fmt::format("  simulated time  {:.3f} s ({} scans)\n", simulated, runtime.scan_count());
   std::cout << fmt::format("  wall time       {:.3f} s\n", wall);
   std::cout << fmt::format("  speed           {:.0f}x real time (simulated seconds per wall second)\n", wall > 0 ? simulated / wall : 0.0);

@@ -34,6 +34,7 @@ const std::vector<Command>& commands() {
       {"campaign", "run a passive fault-injection campaign on the plant model or, armed, on real I/O", plcfi::cli::cmd_campaign},
       {"script", "run CPTest+ test scripts (.cpt) against a program and a plant model, with ASSERT_COM and link faults", plcfi::cli::cmd_script},
       {"history", "show the run history of test scripts, newest first", plcfi::cli::cmd_history},
+      {"plant", "look at a plant's signals (plant info) or export the stamping plant as an FMU (plant export-fmu)", plcfi::cli::cmd_plant},
       {"plant-server", "serve a plant model in real time over Modbus TCP (bench rehearsal)", plcfi::cli::cmd_plant_server},
   };
   return k;

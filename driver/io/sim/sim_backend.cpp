@@ -16,18 +16,20 @@ std::unique_ptr<SimBackend> SimBackend::create(const st::Application& app, std::
     const auto& s = sigs[i];
     rt::ImageRef ref;
     std::string e;
+    // A binding from a plant file is reported at its line there.
+    const std::string at = s.where.empty() ? "plant " + plant->name() + ", signal " + s.name : s.where + ": " + s.name;
     if (!rt::parse_image_ref(app, s.address, &ref, &e)) {
-      *err = "plant " + plant->name() + ", signal " + s.name + ": " + e;
+      *err = at + ": " + e;
       return nullptr;
     }
     char want = s.dir == plant::Direction::FromPlant ? 'I' : 'Q';
     if (ref.area != want) {
-      *err = "plant " + plant->name() + ", signal " + s.name + ": a " +
+      *err = at + ": a " +
              (want == 'I' ? std::string("sensor belongs in %I") : std::string("actuator belongs in %Q")) + ", not " + s.address;
       return nullptr;
     }
     if ((s.kind == plant::SignalKind::Bool) != ref.is_bit) {
-      *err = "plant " + plant->name() + ", signal " + s.name + ": " +
+      *err = at + ": " +
              (ref.is_bit ? "an analog signal needs a word address, not " : "a BOOL signal needs a bit address, not ") + s.address;
       return nullptr;
     }
