@@ -84,6 +84,7 @@ PlantFile read_plant_file(const std::string& path) {
   } else if (root["fmu"]) {
     pf.kind = PlantFile::Kind::Fmu;
     pf.fmu = resolve(path, doc.scalar(root["fmu"], "fmu"));
+    pf.fmu_where = doc.where(root["fmu"]);
   } else {
     pf.kind = PlantFile::Kind::St;
     const auto files = root["st"];

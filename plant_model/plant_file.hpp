@@ -56,6 +56,7 @@ struct PlantFile {
   std::string builtin;              // Builtin: the model's name
   std::string config;               // Builtin: its parameter file (resolved), may be empty
   std::string fmu;                  // Fmu: the archive (resolved)
+  std::string fmu_where;            // Fmu: FILE:LINE:COL of the fmu: value
   std::vector<std::string> st;      // St: the source files (resolved)
   std::string program;              // St: the PROGRAM instance (empty: the only one)
   std::vector<Parameter> stats;     // St: variables reported as the plant's statistics (value unused)

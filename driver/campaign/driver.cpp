@@ -268,7 +268,9 @@ class PassiveDriver final : public rt::ScanHooks {
     exec_.inject_ns = r.now();
     if (opt_.vcd && !opt_.out_dir.empty()) {
       exec_.vcd = fmt::format("{}_path{}.vcd", tc.id, exec_.path);
-      trace_ = report::open_vcd((std::filesystem::path(opt_.out_dir) / exec_.vcd).string(), cb_.watch, &err);
+      trace_ = report::open_vcd((std::filesystem::path(opt_.out_dir) / exec_.vcd).string(), cb_.watch, &err,
+                                fmt::format("campaign {} case {} path {} on plant {}", cb_.spec.name, tc.id, exec_.path,
+                                            cb_.spec.plant));
       if (!trace_) exec_.vcd.clear();
     }
   }
@@ -351,6 +353,7 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
     }
     std::string path = (std::filesystem::path(opt.out_dir) / "results.jsonl").string();
     JournalState st;
+    journal.set_plant(c.plant);
     if (!journal.open(path, opt.resume, c.name, fingerprint, cb.cases, &st, err)) return false;
     for (auto& e : st.executions) {
       driver.mark_tested(e);

@@ -72,6 +72,7 @@ bool Journal::open(const std::string& path, bool resume, const std::string& camp
   Json head;
   head["journal"] = "plcfi campaign";
   head["campaign"] = campaign;
+  if (!plant_.empty()) head["plant"] = plant_;
   head["fingerprint"] = fingerprint;
   head["cases"] = cases.size();
   const std::string header = common::json_compact(head);

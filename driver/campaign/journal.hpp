@@ -34,13 +34,16 @@ class Journal {
   bool open(const std::string& path, bool resume, const std::string& campaign, const std::string& fingerprint,
             const std::vector<TestCase>& cases, JournalState* state, std::string* err);
   bool is_open() const { return f_ != nullptr; }
+  // The plant the campaign runs on (a built-in name or a plant file), written into the
+  // header line by open().
+  void set_plant(std::string plant) { plant_ = std::move(plant); }
   // Appends one verdict and forces it to disk.
   bool append(const Execution& e, const Progress& p, std::string* err);
 
  private:
   bool write_line(const std::string& line, std::string* err);
   std::FILE* f_ = nullptr;
-  std::string path_;
+  std::string path_, plant_;
   const std::vector<TestCase>* cases_ = nullptr;
 };
 

@@ -397,6 +397,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
       suite.cases.push_back(jc);
     }
     suite.properties = res.realtime;
+    suite.properties.emplace_back("plant", cb.spec.plant);
     for (size_t i = 0; i < io_report.size(); ++i) suite.properties.emplace_back(fmt::format("io_{}", i), io_report[i]);
     if (res.interrupted) suite.properties.emplace_back("incomplete", res.end_reason);
     for (size_t i : res.pending) {

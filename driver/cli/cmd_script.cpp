@@ -230,7 +230,7 @@ int cmd_script(const std::vector<std::string>& args) {
       std::cerr << "plcfi script: " << err << "\n";
       return 2;
     }
-    where = "plant " + plant->name();
+    where = "plant " + plant->name() + (plant->origin().empty() ? "" : " (" + plant->origin() + ")");
     if (!(sim = io::SimBackend::create(app, std::move(plant), &err))) {
       std::cerr << "plcfi script: " << err << "\n";
       return 2;

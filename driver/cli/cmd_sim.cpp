@@ -230,7 +230,9 @@ int cmd_sim(const std::vector<std::string>& args) {
   }
   std::vector<std::unique_ptr<report::TraceWriter>> writers;
   if (vm.count("vcd")) {
-    auto w = report::open_vcd(vm["vcd"].as<std::string>(), watch, &err);
+    const std::string origin = backend->plant().origin();
+    auto w = report::open_vcd(vm["vcd"].as<std::string>(), watch, &err,
+                              fmt::format("plcfi sim on plant {}{}", backend->plant().name(), origin.empty() ? "" : ": " + origin));
     if (!w) {
       std::cerr << "plcfi sim: --vcd: " << err << "\n";
       return 2;

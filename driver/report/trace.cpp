@@ -58,12 +58,22 @@ enum class VcdKind { Wire, Integer, Real };
 
 class VcdWriter final : public TraceWriter {
  public:
-  bool init(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err) {
+  bool init(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err, const std::string& comment) {
     for (const auto& v : vars)
       if (!traceable(v, err)) return false;
     if (!sink_.open(path, err)) return false;
     vars_ = vars;
-    sink_.put("$version plcfi $end\n$timescale 1ns $end\n");
+    sink_.put("$version plcfi $end\n");
+    if (!comment.empty()) {
+      // "$end" inside the text would end the comment early: its '$' becomes 'S'.
+      std::string c;
+      for (size_t i = 0; i < comment.size(); ++i)
+        c.push_back(comment[i] == '$' && comment.compare(i, 4, "$end") == 0 ? 'S' : comment[i]);
+      sink_.put("$comment ");
+      sink_.put(c);
+      sink_.put(" $end\n");
+    }
+    sink_.put("$timescale 1ns $end\n");
     // Hierarchy from the dotted paths: Main.cyl.Valve -> scope Main, scope cyl, var Valve.
     std::vector<std::string> open_scopes;
     for (size_t i = 0; i < vars_.size(); ++i) {
@@ -203,9 +213,10 @@ class CsvWriter final : public TraceWriter {
 
 }  // namespace
 
-std::unique_ptr<TraceWriter> open_vcd(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err) {
+std::unique_ptr<TraceWriter> open_vcd(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err,
+                                      const std::string& comment) {
   auto w = std::make_unique<VcdWriter>();
-  if (!w->init(path, vars, err)) return nullptr;
+  if (!w->init(path, vars, err, comment)) return nullptr;
   return w;
 }
 

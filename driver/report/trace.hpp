@@ -23,7 +23,9 @@ class TraceWriter {
 
 // Opens `path` for a VCD trace of `vars`. Fails for unwritable files and for variables
 // VCD cannot represent (strings, arrays, structures: name their elements instead).
-std::unique_ptr<TraceWriter> open_vcd(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err);
+// `comment`, when not empty, goes into the header as a $comment (what ran on which plant).
+std::unique_ptr<TraceWriter> open_vcd(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err,
+                                      const std::string& comment = "");
 // CSV with a header `time,<path>,...`; time in seconds; BOOL as 0/1.
 std::unique_ptr<TraceWriter> open_csv(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err);
 

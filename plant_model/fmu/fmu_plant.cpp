@@ -33,7 +33,12 @@ std::string names_of(const ModelDescription& md, Causality c) {
 
 std::unique_ptr<FmuPlant> FmuPlant::create(const PlantFile& pf) {
   std::unique_ptr<FmuPlant> p(new FmuPlant());
-  p->archive_ = FmuArchive::open(pf.fmu);
+  try {
+    p->archive_ = FmuArchive::open(pf.fmu);
+  } catch (const common::InputError& e) {
+    // Where the plant file names the FMU, then what is wrong with it.
+    throw common::InputError(pf.fmu_where + ": fmu: " + e.what());
+  }
   const ModelDescription& md = p->archive_->description();
   p->name_ = md.model_name;
   p->origin_ = fmt::format("{} (FMU {}, FMI {} co-simulation)", pf.path, pf.fmu, md.fmi_version);
@@ -178,8 +183,10 @@ void FmuPlant::initialize() {
 void FmuPlant::reset(uint64_t seed) {
   // The seed reaches an FMU only through the plant file's seed_parameter.
   seed_ = static_cast<fmi2Integer>(seed & 0x7fffffff);
+  failed_ = true;
   instance_->reset();
   initialize();
+  failed_ = false;
 }
 
 void FmuPlant::exchange_outputs() {
@@ -202,7 +209,10 @@ void FmuPlant::exchange_outputs() {
 
 void FmuPlant::step(double dt, const double* actuators, double* sensors) {
   pending_ns_ += std::llround(dt * 1e9);
-  if (pending_ns_ >= step_ns_) {
+  // After a failure the FMU is not called again (its error was thrown once; the safe
+  // outputs written on the way out must not throw a second time).
+  if (!failed_ && pending_ns_ >= step_ns_) {
+    failed_ = true;  // until this exchange completes
     // The PLC's outputs of this scan, held for the steps it covers.
     if (!in_real_.vr.empty()) {
       for (size_t k = 0; k < in_real_.vr.size(); ++k) {
@@ -226,6 +236,7 @@ void FmuPlant::step(double dt, const double* actuators, double* sensors) {
       ++steps_;
     }
     exchange_outputs();
+    failed_ = false;
   }
   sense(sensors);
 }

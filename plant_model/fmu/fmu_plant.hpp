@@ -63,6 +63,7 @@ class FmuPlant final : public Plant {
   std::unique_ptr<FmuArchive> archive_;
   std::unique_ptr<FmuInstance> instance_;
   int64_t step_ns_ = 0, t_ns_ = 0, pending_ns_ = 0, stop_ns_ = 0;
+  bool failed_ = false;    // an FMU call threw: the FMU is not called again
   bool has_seed_ = false;  // the plant file's seed_parameter: an Integer parameter
   fmi2ValueReference seed_ref_ = 0;
   fmi2Integer seed_ = 1;

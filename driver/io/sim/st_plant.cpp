@@ -106,6 +106,7 @@ std::unique_ptr<StPlant> StPlant::create(const plant::PlantFile& pf) {
 
 void StPlant::reset(uint64_t seed) {
   runtime_->cold_restart(seed);
+  failed_ = false;
   if (runtime_->stopped()) throw PlantProgramError(fmt::format("the ST plant {}: {}", name_, runtime_->stop_reason()));
   for (const Preset& pr : presets_) {
     std::string err;
@@ -132,7 +133,8 @@ void StPlant::read_sensors() {
 
 void StPlant::step(double dt, const double* actuators, double* sensors) {
   pending_ns_ += std::llround(dt * 1e9);
-  if (pending_ns_ >= step_ns_) {
+  // A plant program that trapped is reported once; it is not scanned again.
+  if (!failed_ && pending_ns_ >= step_ns_) {
     st::Machine& m = runtime_->machine();
     for (size_t i = 0; i < bind_.size(); ++i) {
       if (signals_[i].dir != plant::Direction::ToPlant) continue;
@@ -144,8 +146,10 @@ void StPlant::step(double dt, const double* actuators, double* sensors) {
       }
     }
     while (pending_ns_ >= step_ns_) {
-      if (runtime_->scan() == rt::ScanStatus::Trapped)
+      if (runtime_->scan() == rt::ScanStatus::Trapped) {
+        failed_ = true;
         throw PlantProgramError(fmt::format("the ST plant {} stopped: {}", name_, runtime_->stop_reason()));
+      }
       pending_ns_ -= step_ns_;
       ++scans_;
     }

@@ -60,6 +60,7 @@ class StPlant final : public plant::Plant {
   std::vector<double> values_;
   int64_t step_ns_ = 0, pending_ns_ = 0;
   uint64_t scans_ = 0;
+  bool failed_ = false;
 };
 
 // A runtime error (trap) in an ST plant: the run cannot go on with the plant stopped.
