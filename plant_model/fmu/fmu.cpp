@@ -338,6 +338,8 @@ template <class F>
 fmi2Status FmuInstance::guarded(std::string_view call, F&& f) {
   if (dead_) fail(call, "not called: the FMU crashed or failed fatally before");
   current_call_ = call;
+  // Inside batch() the guard is armed already: the call only names itself.
+  if (t_guard && t_current == this) return f();
   t_current = this;
   sigjmp_buf buf;
   // No signal mask saved (savemask 0): no system call per call. The handler runs with
@@ -345,10 +347,22 @@ fmi2Status FmuInstance::guarded(std::string_view call, F&& f) {
   // members are read (nothing local that the call could have changed).
   if (sigsetjmp(buf, 0) != 0) crashed();
   t_guard = &buf;
-  fmi2Status s = f();
-  t_guard = nullptr;
-  t_current = nullptr;
-  return s;
+  // Disarmed however f ends (a batch throws FmuError for a bad status): a crash later
+  // must never jump into this frame once it is gone.
+  struct Disarm {
+    ~Disarm() {
+      t_guard = nullptr;
+      t_current = nullptr;
+    }
+  } disarm;
+  return f();
+}
+
+void FmuInstance::batch(void (*fn)(void*), void* context) {
+  guarded("fmi2 exchange", [&] {
+    fn(context);
+    return fmi2OK;
+  });
 }
 
 void FmuInstance::crashed() {

@@ -103,6 +103,9 @@ class FmuInstance {
   void get_boolean(const std::vector<fmi2ValueReference>& vr, std::vector<fmi2Boolean>* v);
   // fmi2DoStep(t, h).
   void do_step(double t, double h);
+  // Runs fn(context), a sequence of the calls above, under one arming of the crash guard
+  // (the per-step exchange of a plant: sets, steps and gets at the cost of one).
+  void batch(void (*fn)(void*), void* context);
 
   // The last message the FMU logged (its logger callback), or "".
   const std::string& last_message() const { return last_message_; }

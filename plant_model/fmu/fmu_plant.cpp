@@ -208,11 +208,25 @@ void FmuPlant::exchange_outputs() {
 }
 
 void FmuPlant::step(double dt, const double* actuators, double* sensors) {
-  pending_ns_ += std::llround(dt * 1e9);
+  if (dt != last_dt_) {  // the scan's tick, nearly always the same
+    last_dt_ = dt;
+    last_dt_ns_ = std::llround(dt * 1e9);
+  }
+  pending_ns_ += last_dt_ns_;
   // After a failure the FMU is not called again (its error was thrown once; the safe
   // outputs written on the way out must not throw a second time).
   if (!failed_ && pending_ns_ >= step_ns_) {
     failed_ = true;  // until this exchange completes
+    actuators_ = actuators;
+    instance_->batch([](void* self) { static_cast<FmuPlant*>(self)->exchange(); }, this);
+    failed_ = false;
+  }
+  sense(sensors);
+}
+
+void FmuPlant::exchange() {
+  const double* actuators = actuators_;
+  {
     // The PLC's outputs of this scan, held for the steps it covers.
     if (!in_real_.vr.empty()) {
       for (size_t k = 0; k < in_real_.vr.size(); ++k) {
@@ -236,9 +250,7 @@ void FmuPlant::step(double dt, const double* actuators, double* sensors) {
       ++steps_;
     }
     exchange_outputs();
-    failed_ = false;
   }
-  sense(sensors);
 }
 
 void FmuPlant::sense(double* sensors) const {

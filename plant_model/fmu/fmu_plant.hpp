@@ -44,6 +44,7 @@ class FmuPlant final : public Plant {
     std::optional<Scale> scale;
   };
   void initialize();
+  void exchange();  // inputs, the due steps, outputs: one batch of FMU calls
   void exchange_outputs();
 
   std::string name_, origin_;
@@ -68,6 +69,9 @@ class FmuPlant final : public Plant {
   fmi2ValueReference seed_ref_ = 0;
   fmi2Integer seed_ = 1;
   uint64_t steps_ = 0;
+  double last_dt_ = -1.0;
+  int64_t last_dt_ns_ = 0;
+  const double* actuators_ = nullptr;  // of the step() in progress
 };
 
 }  // namespace plcfi::plant::fmu
