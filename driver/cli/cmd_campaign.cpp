@@ -98,7 +98,7 @@ bool write_diagrams(const CampaignBuild& cb, const std::string& dir, std::string
 
 // Loads and generates; prints errors and returns false (exit 2) when the specs are bad.
 bool load_and_prepare(const std::string& path, const std::vector<std::string>& programs, const uint64_t* seed,
-                      CampaignBuild* cb) {
+                      CampaignBuild* cb, const std::string& plant = "") {
   campaign::Campaign spec;
   std::string err;
   if (!campaign::load_campaign(path, &spec, &err)) {
@@ -107,6 +107,10 @@ bool load_and_prepare(const std::string& path, const std::vector<std::string>& p
   }
   if (!programs.empty()) spec.programs = programs;
   if (seed) spec.seed = *seed;
+  if (!plant.empty()) {
+    spec.plant = plant;  // as given on the command line: relative to the working folder
+    spec.plant_config.clear();
+  }
   if (!campaign::prepare_campaign(std::move(spec), cb, &err)) {
     std::cerr << err << (err.empty() || err.back() == '\n' ? "" : "\n");
     return false;
@@ -210,13 +214,14 @@ int cmd_generate(const std::vector<std::string>& args) {
 
 int cmd_campaign(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--seed N] [--no-vcd] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]]";
+      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--no-vcd] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]]";
   po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
   desc.add_options()
       ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
       ("resume", "finish a campaign whose journal is in the output folder (no case runs twice)")
       ("junit", po::value<std::string>(), "write JUnit XML")
       ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
+      ("plant", po::value<std::string>(), "plant instead of the campaign's: a built-in plant's name or a plant file (FMU, ST)")
       ("seed", po::value<Count>(), "seed instead of the campaign's")
       ("no-vcd", "no VCD trace per test")
       ("quiet", "no live progress line")
@@ -232,7 +237,8 @@ int cmd_campaign(const std::vector<std::string>& args) {
   std::vector<std::string> programs;
   if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
   uint64_t seed = vm.count("seed") ? vm["seed"].as<Count>().value : 0;
-  if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, vm.count("seed") ? &seed : nullptr, &cb))
+  if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, vm.count("seed") ? &seed : nullptr, &cb,
+                        vm.count("plant") ? vm["plant"].as<std::string>() : ""))
     return 2;
   const auto& c = cb.spec;
   std::string out = vm.count("out") ? vm["out"].as<std::string>()
