@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "common/duration.hpp"
 #include "common/yaml.hpp"
 
 #include "trace_reader.hpp"
@@ -279,6 +280,33 @@ st::GeneratedSource MonitorSource::source(const std::string& reqs_path, bool exa
 
 // ------------------------------------------------------------------ checking
 
+namespace {
+
+// The durations of every PASSED(<literal>) in `up` (upper case, as st::canon gives it)
+// into *out; false when a PASSED takes anything but one duration literal (a variable, an
+// expression): then the elapsed time matters in ways the cache cannot know.
+bool passed_literals(const std::string& up, std::vector<int64_t>* out) {
+  for (size_t at = up.find("PASSED"); at != std::string::npos; at = up.find("PASSED", at + 6)) {
+    // Only the operator: a name that merely contains the word (MYPASSED, PASSED_X) is not.
+    auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+    if ((at > 0 && ident(up[at - 1])) || (at + 6 < up.size() && ident(up[at + 6]))) continue;
+    size_t p = up.find_first_not_of(" \t", at + 6);
+    if (p == std::string::npos || up[p] != '(') return false;
+    const size_t close = up.find(')', p);
+    if (close == std::string::npos) return false;
+    std::string arg = up.substr(p + 1, close - p - 1);
+    while (!arg.empty() && std::isspace(static_cast<unsigned char>(arg.back()))) arg.pop_back();
+    while (!arg.empty() && std::isspace(static_cast<unsigned char>(arg.front()))) arg.erase(arg.begin());
+    if (arg.find('#') == std::string::npos) return false;
+    const common::DurationParse d = common::parse_duration(arg);
+    if (!d.error.empty()) return false;
+    out->push_back(d.ns);
+  }
+  return true;
+}
+
+}  // namespace
+
 std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const RequirementsFile& reqs, std::string* err) {
   return create(app, reqs, 0, reqs.requirements.size(), err);
 }
@@ -329,10 +357,16 @@ std::unique_ptr<MonitorSet> MonitorSet::create(const st::Application& app, const
     r.state.type = sn->type;
     r.state.addr = inst->addr + sn->offset;
     const FormulaSource* fs[] = {&spec.trigger, &spec.invariant, &spec.final, &spec.delay, &spec.reaction, &spec.release};
+    r.passed_known = true;
     for (const auto* f : fs) {
       std::string up = st::canon(f->text);
       if (up.find("PASSED") != std::string::npos) r.uses_passed = true;
+      if (!passed_literals(up, &r.thresholds)) r.passed_known = false;
     }
+    std::sort(r.thresholds.begin(), r.thresholds.end());
+    r.thresholds.erase(std::unique(r.thresholds.begin(), r.thresholds.end()), r.thresholds.end());
+    r.cached.assign(r.thresholds.size() + 1, {});
+    r.cached_ok.assign(r.thresholds.size() + 1, 0);
     r.verdict.id = spec.id;
     r.verdict.text = spec.text;
     r.verdict.severity = spec.severity;
@@ -383,6 +417,7 @@ bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
     eval(m, r, 0, base, !r.groups.empty());
     if (base[0] && r.groups.empty()) eval(m, r, 0, base, true);
     bool was_violated = r.verdict.violated();
+    std::fill(r.cached_ok.begin(), r.cached_ok.end(), 0);  // a new state: nothing cached
     if (base[0]) {
       ++r.verdict.triggers;
       r.groups.push_back(Group{false, state, t, state, t, 1});
@@ -398,8 +433,19 @@ bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
       bool done = false;
       const bool* val = base;
       if (r.uses_passed && !(g.timer_time == t)) {
-        eval(m, r, t - g.timer_time, v, true);
-        val = v;
+        const int64_t elapsed = t - g.timer_time;
+        if (r.passed_known) {
+          const size_t k = static_cast<size_t>(std::upper_bound(r.thresholds.begin(), r.thresholds.end(), elapsed) -
+                                               r.thresholds.begin());
+          if (!r.cached_ok[k]) {
+            eval(m, r, elapsed, r.cached[k].data(), true);
+            r.cached_ok[k] = 1;
+          }
+          val = r.cached[k].data();
+        } else {
+          eval(m, r, elapsed, v, true);
+          val = v;
+        }
       }
       if (!g.phase_b) {
         if (val[5]) {
@@ -433,14 +479,31 @@ bool MonitorSet::step(st::Machine& m, uint64_t state, int64_t t) {
     // Instances that behave identically from now on are one group: without PASSED all
     // instances of a phase; with PASSED those sharing their timer point. (In place: the
     // vector's capacity is reused, no allocation per state.)
-    if (r.groups.size() > 1) {
-      size_t kept = 0;
+    if (r.groups.size() > 1 && !r.uses_passed) {
+      size_t kept = 0;  // at most two: one per phase
       for (size_t gi = 0; gi < r.groups.size(); ++gi) {
         const Group& g = r.groups[gi];
         size_t k = 0;
-        while (k < kept && !(r.groups[k].phase_b == g.phase_b && (!r.uses_passed || r.groups[k].timer_time == g.timer_time))) ++k;
+        while (k < kept && r.groups[k].phase_b != g.phase_b) ++k;
         if (k < kept) r.groups[k].count += g.count;
         else r.groups[kept++] = g;
+      }
+      r.groups.resize(kept);
+    } else if (r.groups.size() > 1) {
+      // Keys (phase, timer point) were unique after the last state; only a group whose
+      // timer point is this state (a new trigger, or one that entered phase b now) can
+      // share its key, so one pass merges (linear, where comparing all pairs was
+      // quadratic in the open instances of a long deadline).
+      size_t kept = 0, now_a = SIZE_MAX, now_b = SIZE_MAX;
+      for (size_t gi = 0; gi < r.groups.size(); ++gi) {
+        const Group& g = r.groups[gi];
+        size_t* slot = g.timer_time == t ? (g.phase_b ? &now_b : &now_a) : nullptr;
+        if (slot && *slot != SIZE_MAX) {
+          r.groups[*slot].count += g.count;
+          continue;
+        }
+        if (slot) *slot = kept;
+        r.groups[kept++] = g;
       }
       r.groups.resize(kept);
     }

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -121,6 +122,14 @@ class MonitorSet {
     st::VarHandle elapsed, state, full;
     const st::StateShift* shift = nullptr;
     bool uses_passed = false;
+    // When every PASSED(...) of the requirement takes a duration literal, the formulas
+    // depend on an instance's elapsed time only through which of these (sorted) it has
+    // passed: instances between the same two thresholds get the same values at a state,
+    // so one evaluation serves them all. Empty with passed_known false: no such cache.
+    std::vector<int64_t> thresholds;
+    bool passed_known = false;
+    std::vector<std::array<bool, 6>> cached;  // per threshold interval, this state
+    std::vector<uint8_t> cached_ok;
     std::vector<Group> groups;
     Verdict verdict;
   };

@@ -290,6 +290,18 @@ TEST(EdtlProperty, IncrementalMonitorEqualsTheDefinitionOnRandomTraces) {
          return Direct{[n](size_t k, int64_t) { return k > 0 && n[k] > n[k - 1]; }, nval(b), passed(10'000'000), passed(20'000'000),
                        val(a), konst(false)};
        }},
+      // Level triggers open an instance at every state: many open instances with their own
+      // timer points (the merge and the evaluation per threshold interval must not change
+      // a count).
+      {"trigger: \"a\"\n    delay: \"PASSED(T#40ms)\"\n    reaction: \"b\"\n",
+       [&](auto& a, auto& b, auto&) { return Direct{val(a), konst(true), konst(true), passed(40'000'000), val(b), konst(false)}; }},
+      {"trigger: \"a OR b\"\n    invariant: \"NOT PASSED(T#70ms) OR n < 6\"\n    final: \"PASSED(T#20ms) AND b\"\n    delay: \"PASSED(T#30ms)\"\n    reaction: \"n = 2\"\n",
+       [&](auto& a, auto& b, auto& n) {
+         return Direct{[a, b](size_t k, int64_t) { return a[k] || b[k]; },
+                       [n](size_t k, int64_t el) { return el < 70'000'000 || n[k] < 6; },
+                       [b](size_t k, int64_t el) { return el >= 20'000'000 && b[k]; }, passed(30'000'000),
+                       [n](size_t k, int64_t) { return n[k] == 2; }, konst(false)};
+       }},
       {"trigger: \"HIGH(a) AND CHANGES(n)\"\n    final: \"b\"\n    delay: \"TRUE\"\n    reaction: \"NOT a\"\n",
        [&](auto& a, auto& b, auto& n) {
          return Direct{[a, n](size_t k, int64_t) { return k > 0 && a[k] && a[k - 1] && n[k] != n[k - 1]; }, konst(true), val(b),
@@ -332,7 +344,7 @@ TEST(EdtlProperty, IncrementalMonitorEqualsTheDefinitionOnRandomTraces) {
       ++runs;
     }
   }
-  EXPECT_EQ(360, runs);
+  EXPECT_EQ(480, runs);
 }
 
 }  // namespace
