@@ -100,7 +100,8 @@ PlantFile read_plant_file(const std::string& path) {
   only_for("stop_time", PlantFile::Kind::Fmu, "fmu");
   only_for("seed_parameter", PlantFile::Kind::Fmu, "fmu");
   only_for("program", PlantFile::Kind::St, "st");
-  only_for("stats", PlantFile::Kind::St, "st");
+  if (root["stats"] && pf.kind == PlantFile::Kind::Builtin)
+    doc.fail(root["stats"], "stats: a built-in plant reports its own statistics");
   only_for("config", PlantFile::Kind::Builtin, "builtin");
   if (pf.kind == PlantFile::Kind::Builtin && root["parameters"])
     doc.fail(root["parameters"], "parameters: a built-in plant takes its parameters from a file: use config:");

@@ -8,7 +8,7 @@
 //   seed_parameter: seed       # FMU only, optional: an Integer parameter set to the run's seed
 //   parameters: {Speed: 0.5}   # FMU start values / ST initial values, by name
 //   program: TankPlant         # ST only, optional: the PROGRAM instance to scan
-//   stats: [stamped, defective]  # ST only, optional: variables shown as the plant's statistics
+//   stats: [stamped, defective]  # FMU or ST, optional: variables shown as the plant's statistics
 //   config: my-stamping.yaml   # built-in only, optional: its parameter file
 //   map:                       # %I: the plant writes it (sensor); %Q: the plant reads it
 //     - {image: "%QX0.0", plant: Motor}
@@ -59,7 +59,7 @@ struct PlantFile {
   std::string fmu_where;            // Fmu: FILE:LINE:COL of the fmu: value
   std::vector<std::string> st;      // St: the source files (resolved)
   std::string program;              // St: the PROGRAM instance (empty: the only one)
-  std::vector<Parameter> stats;     // St: variables reported as the plant's statistics (value unused)
+  std::vector<Parameter> stats;     // Fmu, St: variables reported as the plant's statistics (value unused)
   int64_t step_ns = 0;              // 0: not given
   std::string step_where;
   int64_t stop_time_ns = 0;         // 0: not given

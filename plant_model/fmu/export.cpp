@@ -53,6 +53,12 @@ std::string stamping_model_description(const Plant& plant, int64_t step_ns) {
       "travel times\" causality=\"parameter\" variability=\"fixed\">\n      <Integer start=\"1\"/>\n    "
       "</ScalarVariable>\n",
       kStampingFmuSeedRef);
+  const auto stats = plant.stats();
+  for (size_t k = 0; k < stats.size(); ++k)
+    vars += fmt::format(
+        "    <ScalarVariable name=\"{}\" valueReference=\"{}\" description=\"statistics of the run\" "
+        "causality=\"local\" variability=\"discrete\" initial=\"calculated\">\n      <Integer/>\n    </ScalarVariable>\n",
+        xml_escape(stats[k].first), kStampingFmuStatsRef + k);
   return fmt::format(
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{name}\" guid=\"{guid}\"\n"
@@ -111,6 +117,8 @@ void export_stamping_fmu(const Plant& plant, const ExportOptions& opt) {
   if (ec) throw common::InputError(fmt::format("{}: cannot write: {}", opt.out, ec.message()));
 
   if (opt.plant_file.empty()) return;
+  std::string stat_names;
+  for (const auto& [name, value] : plant.stats()) stat_names += (stat_names.empty() ? "" : ", ") + name;
   // The FMU path relative to the plant file, so the two can move together.
   fs::path rel = fs::absolute(opt.out).lexically_relative(fs::absolute(opt.plant_file).parent_path());
   std::string text = fmt::format(
@@ -119,8 +127,9 @@ void export_stamping_fmu(const Plant& plant, const ExportOptions& opt) {
       "fmu: {}\n"
       "step: {}\n"
       "seed_parameter: seed   # the run's seed goes to this Integer parameter at every restart\n"
+      "stats: [{}]\n"
       "map:\n",
-      rel.empty() ? opt.out : rel.string(), common::format_duration(opt.step_ns));
+      rel.empty() ? opt.out : rel.string(), common::format_duration(opt.step_ns), stat_names);
   for (const auto& s : plant.signals())
     text += fmt::format("  - {{image: \"{}\", plant: {}}}\n", s.address, s.name);
   std::ofstream f(opt.plant_file, std::ios::binary | std::ios::trunc);

@@ -148,6 +148,15 @@ std::unique_ptr<FmuPlant> FmuPlant::create(const PlantFile& pf) {
     }
   }
 
+  for (const Parameter& s : pf.stats) {
+    const ScalarVariable* v = md.find(s.name);
+    if (!v) fail_at(s.where, fmt::format("stats: the FMU has no variable '{}'", s.name));
+    if (v->type != VarType::Real && v->type != VarType::Integer && v->type != VarType::Boolean)
+      fail_at(s.where, fmt::format("stats: '{}' is a {} variable; statistics are Real, Integer or Boolean", s.name,
+                                   type_name(v->type)));
+    p->stats_.push_back({s.name, v->type, v->value_reference});
+  }
+
   if (!pf.seed_parameter.empty()) {
     const ScalarVariable* v = md.find(pf.seed_parameter);
     if (!v || v->type != VarType::Integer || v->causality != Causality::Parameter)
@@ -259,7 +268,33 @@ void FmuPlant::sense(double* sensors) const {
 }
 
 std::vector<std::pair<std::string, double>> FmuPlant::stats() const {
-  return {{"fmu_steps", static_cast<double>(steps_)}, {"fmu_time_s", static_cast<double>(t_ns_) / 1e9}};
+  std::vector<std::pair<std::string, double>> out;
+  if (!failed_) {
+    try {
+      for (const Stat& s : stats_) {
+        double v = 0;
+        if (s.type == VarType::Real) {
+          std::vector<fmi2Real> r(1);
+          instance_->get_real({s.vr}, &r);
+          v = r[0];
+        } else if (s.type == VarType::Integer) {
+          std::vector<fmi2Integer> r(1);
+          instance_->get_integer({s.vr}, &r);
+          v = r[0];
+        } else {
+          std::vector<fmi2Boolean> r(1);
+          instance_->get_boolean({s.vr}, &r);
+          v = r[0] != fmi2False ? 1 : 0;
+        }
+        out.emplace_back(s.name, v);
+      }
+    } catch (const FmuError&) {
+      out.clear();  // a summary is no place to fail; the run reported its own errors
+    }
+  }
+  out.emplace_back("fmu_steps", static_cast<double>(steps_));
+  out.emplace_back("fmu_time_s", static_cast<double>(t_ns_) / 1e9);
+  return out;
 }
 
 }  // namespace plcfi::plant::fmu

@@ -72,6 +72,12 @@ class FmuPlant final : public Plant {
   double last_dt_ = -1.0;
   int64_t last_dt_ns_ = 0;
   const double* actuators_ = nullptr;  // of the step() in progress
+  struct Stat {
+    std::string name;
+    VarType type;
+    fmi2ValueReference vr;
+  };
+  std::vector<Stat> stats_;  // the plant file's stats: variables
 };
 
 }  // namespace plcfi::plant::fmu

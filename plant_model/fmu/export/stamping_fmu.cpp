@@ -2,7 +2,8 @@
 // `plcfi plant export-fmu` packs). Variables follow the plant's signal list: signal i has
 // value reference i, an actuator is an input, a sensor an output, a BOOL signal Boolean,
 // an analog one Integer in the image's units. Integer parameter "seed" (value reference
-// 1000) seeds the plant's random variation, as --seed does for the built-in plant.
+// 1000) seeds the plant's random variation, as --seed does for the built-in plant; local
+// Integer variables from value reference 2000 count workpieces, strokes and collisions.
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -23,6 +24,7 @@ using plcfi::plant::StampingPlant;
 
 constexpr const char* kGuid = plcfi::plant::fmu::kStampingFmuGuid;
 constexpr fmi2ValueReference kSeedRef = plcfi::plant::fmu::kStampingFmuSeedRef;
+constexpr fmi2ValueReference kStatsRef = plcfi::plant::fmu::kStampingFmuStatsRef;
 
 enum class State { Instantiated, Initialization, Stepping, Terminated, Error };
 
@@ -153,6 +155,12 @@ FMI2_EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference 
   for (size_t k = 0; k < n; ++k) {
     if (vr[k] == kSeedRef) {
       value[k] = in->seed;
+      continue;
+    }
+    if (vr[k] >= kStatsRef) {
+      const auto stats = in->plant.stats();
+      if (vr[k] - kStatsRef >= stats.size()) return fail(in, "no Integer variable %u", vr[k]);
+      value[k] = static_cast<fmi2Integer>(stats[vr[k] - kStatsRef].second);
       continue;
     }
     const int i = signal_of(in, vr[k], SignalKind::Analog);

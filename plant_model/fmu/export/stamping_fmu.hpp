@@ -8,6 +8,9 @@ inline constexpr const char* kStampingFmuGuid = "{5f0c1d2e-7a43-4b8e-9c61-3d2a8e
 inline constexpr const char* kStampingFmuIdentifier = "stamping";
 // The Integer parameter that seeds the plant's random variation.
 inline constexpr unsigned kStampingFmuSeedRef = 1000;
+// The plant's statistics (workpieces_stamped, ...) are local Integer variables from here on,
+// in the order StampingPlant::stats() gives them.
+inline constexpr unsigned kStampingFmuStatsRef = 2000;
 // File name of the binary, next to the plcfi executable.
 inline constexpr const char* kStampingFmuLibrary = "plcfi_stamping_fmu.so";
 
