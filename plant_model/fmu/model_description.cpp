@@ -27,17 +27,26 @@ class Reader {
  public:
   Reader(const std::string& text, std::string where) : text_(text), where_(std::move(where)) {}
 
-  [[noreturn]] void fail_at(ptrdiff_t offset, const std::string& message) const {
-    uint32_t line = 1, col = 1;
+  // 1-based line and column of a byte offset (a UTF-8 continuation byte is no column).
+  // Variables come in file order: the count goes on from the last offset asked for, so
+  // positioning every variable of a large file stays linear.
+  void line_col(ptrdiff_t offset, uint32_t* line, uint32_t* col) const {
     const size_t end = offset < 0 ? 0 : std::min(static_cast<size_t>(offset), text_.size());
-    for (size_t i = 0; i < end; ++i) {
-      if (text_[i] == '\n') {
-        ++line;
-        col = 1;
-      } else if ((static_cast<unsigned char>(text_[i]) & 0xC0) != 0x80) {
-        ++col;  // a UTF-8 continuation byte is not a column
+    if (end < at_) at_ = 0, line_ = 1, col_ = 1;
+    for (; at_ < end; ++at_) {
+      if (text_[at_] == '\n') {
+        ++line_;
+        col_ = 1;
+      } else if ((static_cast<unsigned char>(text_[at_]) & 0xC0) != 0x80) {
+        ++col_;
       }
     }
+    *line = line_;
+    *col = col_;
+  }
+  [[noreturn]] void fail_at(ptrdiff_t offset, const std::string& message) const {
+    uint32_t line = 0, col = 0;
+    line_col(offset, &line, &col);
     throw common::InputError(fmt::format("{}:{}:{}: {}", where_, line, col, message));
   }
   [[noreturn]] void fail(const pugi::xml_node& n, const std::string& message) const { fail_at(start_of(n), message); }
@@ -47,20 +56,7 @@ class Reader {
     if (o > 0 && static_cast<size_t>(o) <= text_.size() && text_[static_cast<size_t>(o) - 1] == '<') --o;
     return o;
   }
-  void position(const pugi::xml_node& n, uint32_t* line, uint32_t* col) const {
-    *line = 1;
-    *col = 1;
-    const ptrdiff_t o = start_of(n);
-    const size_t end = o < 0 ? 0 : std::min(static_cast<size_t>(o), text_.size());
-    for (size_t i = 0; i < end; ++i) {
-      if (text_[i] == '\n') {
-        ++*line;
-        *col = 1;
-      } else if ((static_cast<unsigned char>(text_[i]) & 0xC0) != 0x80) {
-        ++*col;
-      }
-    }
-  }
+  void position(const pugi::xml_node& n, uint32_t* line, uint32_t* col) const { line_col(start_of(n), line, col); }
 
   std::string required(const pugi::xml_node& n, const char* attr) const {
     pugi::xml_attribute a = n.attribute(attr);
@@ -96,6 +92,8 @@ class Reader {
  private:
   const std::string& text_;
   std::string where_;
+  mutable size_t at_ = 0;  // line_col's position: offset, line and column
+  mutable uint32_t line_ = 1, col_ = 1;
 };
 
 Causality parse_causality(const Reader& r, const pugi::xml_node& n) {

@@ -86,6 +86,22 @@ TEST(ModelDescription, ErrorsNameFileLineAndColumn) {
   EXPECT_NE(with("modelIdentifier=\"m\"", "modelIdentifier=\"../m\"").find("is not a valid file name"), std::string::npos);
 }
 
+TEST(ModelDescription, ManyVariablesAreReadAndTooManyAreAnError) {
+  auto doc = [](size_t n) {
+    std::string t = "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"m\" guid=\"g\">\n"
+                    "<CoSimulation modelIdentifier=\"m\"/>\n<ModelVariables>\n";
+    for (size_t i = 0; i < n; ++i)
+      t += "<ScalarVariable name=\"v" + std::to_string(i) + "\" valueReference=\"" + std::to_string(i) +
+           "\" causality=\"output\"><Real/></ScalarVariable>\n";
+    return t + "</ModelVariables>\n</fmiModelDescription>\n";
+  };
+  auto md = parse_model_description(doc(100'000), "big.xml");
+  ASSERT_EQ(md.variables.size(), 100'000u);
+  EXPECT_EQ(md.variables.back().line, 100'003u);  // positions counted on, not from the start each time
+  EXPECT_EQ(input_error([&] { parse_model_description(doc(100'001), "big.xml"); }),
+            "big.xml:100004:1: more than 100000 variables");
+}
+
 class PlantFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
