@@ -56,6 +56,10 @@ sim "$work/p.yaml:3:21: the FMU has no variable 'Speed' (its parameters: ToggleP
 plant probe.fmu "stop_time: soon"
 sim "$work/p.yaml:3:12: stop_time: expected a duration, got 'soon'"
 
+# An FMU named where a plant file belongs.
+expect "$fmus/probe.fmu: an FMU plant is named by a plant file (YAML: fmu: $fmus/probe.fmu, its step and the map" \
+  "$plcfi" sim "$work/prog.st" --plant "$fmus/probe.fmu" --duration 1s
+
 # A campaign whose plant fails mid-run stops with the FMU's error.
 sed -e "s|^plant: stamping|plant: $work/p.yaml|" -e "s|\.\./\.\./\.\./st_programs|$src/st_programs|" \
     -e "s|^tsd: |tsd: $src/faults/campaigns/stamping/|" -e "s|^fmea: |fmea: $src/faults/campaigns/stamping/|" \

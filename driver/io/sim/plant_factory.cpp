@@ -67,7 +67,19 @@ std::unique_ptr<plant::Plant> open_builtin(const plant::PlantFile& pf) {
 
 std::unique_ptr<plant::Plant> open_plant(const std::string& name_or_file, const std::string& config_path,
                                          std::string* err) {
-  if (!plant::is_plant_file(name_or_file)) return plant::make_plant(name_or_file, config_path, err);
+  if (!plant::is_plant_file(name_or_file)) {
+    auto ends = [&](const char* suffix) {
+      const std::string s(suffix);
+      return name_or_file.size() > s.size() && name_or_file.compare(name_or_file.size() - s.size(), s.size(), s) == 0;
+    };
+    if (ends(".fmu") || ends(".st")) {
+      *err = fmt::format("{}: an {} plant is named by a plant file (YAML: {}: {}, its step and the map onto the image; "
+                         "see README, 'Your own plant')",
+                         name_or_file, ends(".fmu") ? "FMU" : "ST", ends(".fmu") ? "fmu" : "st", name_or_file);
+      return nullptr;
+    }
+    return plant::make_plant(name_or_file, config_path, err);
+  }
   try {
     if (!config_path.empty())
       throw common::InputError(fmt::format("{}: a plant file names its own parameters (config: or parameters:); "
