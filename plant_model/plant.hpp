@@ -59,6 +59,9 @@ class Plant {
   virtual std::string origin() const { return ""; }
   // The plant's own step in ns; 0: it steps with every scan, by the scan's tick.
   virtual int64_t step_ns() const { return 0; }
+  // What a user should know about how the plant is stepped (an FMU stepped at another
+  // step than its DefaultExperiment suggests, ...): one line each, for summaries.
+  virtual std::vector<std::string> notes() const { return {}; }
 };
 
 // Creates a plant by name ("stamping"); config_path may be empty (defaults). Returns null

@@ -50,6 +50,7 @@ int plant_info(const std::vector<std::string>& args) {
   std::cout << fmt::format("plant {}{}\n", plant->name(), plant->origin().empty() ? " (built-in)" : ": " + plant->origin());
   std::cout << (plant->step_ns() > 0 ? fmt::format("  step {}\n", common::format_duration(plant->step_ns()))
                                      : std::string("  step: with every scan, by the base tick\n"));
+  for (const auto& n : plant->notes()) std::cout << "  note: " << n << "\n";
   size_t width = 4;
   for (const auto& s : plant->signals()) width = std::max(width, s.name.size());
   std::cout << fmt::format("  {:<8} {:<{}} {:<9} {:<7} {}\n", "image", "signal", width, "direction", "kind", "description");

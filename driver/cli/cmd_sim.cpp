@@ -285,6 +285,7 @@ int cmd_sim(const std::vector<std::string>& args) {
     const int64_t step = backend->plant().step_ns();
     std::cout << fmt::format("  plant file      {}{}\n", origin,
                              step > 0 ? fmt::format(", plant step {}", common::format_duration(step)) : "");
+    for (const auto& n : backend->plant().notes()) std::cout << "  note            " << n << "\n";
     if (step > sched.tick_ns())
       std::cout << fmt::format("  note            the plant step is coarser than the base tick: the plant's outputs "
                                "change at most every {} scans\n",

@@ -31,6 +31,7 @@ class FmuPlant final : public Plant {
   std::vector<std::pair<std::string, double>> stats() const override;
   std::string origin() const override { return origin_; }
   int64_t step_ns() const override { return step_ns_; }
+  std::vector<std::string> notes() const override { return notes_; }
 
  private:
   FmuPlant() = default;
@@ -48,6 +49,7 @@ class FmuPlant final : public Plant {
   void exchange_outputs();
 
   std::string name_, origin_;
+  std::vector<std::string> notes_;
   std::vector<SignalInfo> signals_;
   std::vector<Binding> bind_;
   Group in_real_, in_int_, in_bool_, out_real_, out_int_, out_bool_;

@@ -212,6 +212,9 @@ TEST_F(FmuPlantTest, ACoarsePlantStepHoldsItsOutputsOverScans) {
     seen.push_back(v[0]);
   }
   EXPECT_EQ(seen, (std::vector<double>{0, 0, 0, 0, 1, 1, 1, 1, 1, 2}));
+  // probe.fmu suggests 10 ms (DefaultExperiment stepSize): the other step is noted.
+  EXPECT_EQ(p->notes(), (std::vector<std::string>{
+                            "the FMU's DefaultExperiment suggests a step of 10ms; the plant file steps it every 50ms"}));
 }
 
 TEST_F(FmuPlantTest, TheMapIsCheckedAgainstModelDescription) {
