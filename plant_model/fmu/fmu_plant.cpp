@@ -57,11 +57,8 @@ std::unique_ptr<FmuPlant> FmuPlant::create(const PlantFile& pf) {
   if (md.default_step && pf.step_ns > 0) {
     const int64_t suggested = std::max<int64_t>(1, std::llround(*md.default_step * 1e9));
     if (suggested != pf.step_ns)
-      p->notes_.push_back(fmt::format("the FMU's DefaultExperiment suggests a step of {}; the plant file steps it every {}{}",
-                                      common::format_duration(suggested), common::format_duration(pf.step_ns),
-                                      md.can_handle_variable_step || pf.step_ns % suggested == 0
-                                          ? ""
-                                          : " (it cannot change its step size: a step it rejects ends the run)"));
+      p->notes_.push_back(fmt::format("the FMU's DefaultExperiment suggests a step of {}; the plant file steps it every {}",
+                                      common::format_duration(suggested), common::format_duration(pf.step_ns)));
   }
   if (md.default_stop && pf.stop_time_ns > 0 && static_cast<double>(pf.stop_time_ns) * 1e-9 > *md.default_stop)
     p->notes_.push_back(fmt::format("stop_time {} is later than the FMU's DefaultExperiment stopTime {} s",
