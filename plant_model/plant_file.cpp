@@ -71,7 +71,7 @@ PlantFile read_plant_file(const std::string& path) {
   pf.path = path;
   pf.where = path + ":1:1";
   if (!root.IsMap()) doc.fail(root, "a plant file: expected a map (builtin:, fmu: or st:, then step:, map:), got " + YamlDoc::describe(root));
-  doc.check_keys(root, {"builtin", "fmu", "st", "step", "stop_time", "seed_parameter", "parameters", "program", "stats", "config", "map"},
+  doc.check_keys(root, {"builtin", "fmu", "st", "step", "stop_time", "seed_parameter", "call_timeout", "parameters", "program", "stats", "config", "map"},
                  "the plant file");
 
   int kinds = (root["builtin"] ? 1 : 0) + (root["fmu"] ? 1 : 0) + (root["st"] ? 1 : 0);
@@ -99,6 +99,7 @@ PlantFile read_plant_file(const std::string& path) {
   };
   only_for("stop_time", PlantFile::Kind::Fmu, "fmu");
   only_for("seed_parameter", PlantFile::Kind::Fmu, "fmu");
+  only_for("call_timeout", PlantFile::Kind::Fmu, "fmu");
   only_for("program", PlantFile::Kind::St, "st");
   if (root["stats"] && pf.kind == PlantFile::Kind::Builtin)
     doc.fail(root["stats"], "stats: a built-in plant reports its own statistics");
@@ -112,6 +113,10 @@ PlantFile read_plant_file(const std::string& path) {
     pf.step_where = doc.where(n);
   }
   if (const auto n = root["stop_time"]) pf.stop_time_ns = doc.duration(n, "stop_time", 1);
+  if (const auto n = root["call_timeout"]) {
+    pf.call_timeout_ns = doc.duration(n, "call_timeout", 1'000'000);
+    if (pf.call_timeout_ns > 3600'000'000'000) doc.fail(n, "call_timeout: at most 1h");
+  }
   if (const auto n = root["program"]) pf.program = doc.scalar(n, "program");
   if (const auto n = root["seed_parameter"]) {
     pf.seed_parameter = doc.scalar(n, "seed_parameter");

@@ -6,6 +6,7 @@
 //   step: 1ms                  # the plant's step, independent of the PLC cycle
 //   stop_time: 1h              # FMU only, optional: the stop time of fmi2SetupExperiment
 //   seed_parameter: seed       # FMU only, optional: an Integer parameter set to the run's seed
+//   call_timeout: 10s          # FMU only, optional: an FMU call taking longer is a hang (an error)
 //   parameters: {Speed: 0.5}   # FMU start values / ST initial values, by name
 //   program: TankPlant         # ST only, optional: the PROGRAM instance to scan
 //   stats: [stamped, defective]  # FMU or ST, optional: variables shown as the plant's statistics
@@ -63,6 +64,7 @@ struct PlantFile {
   int64_t step_ns = 0;              // 0: not given
   std::string step_where;
   int64_t stop_time_ns = 0;         // 0: not given
+  int64_t call_timeout_ns = 10'000'000'000;  // Fmu: a call that takes longer is a hang
   std::string seed_parameter;       // Fmu: an Integer parameter that takes the run's seed
   std::string seed_where;
   std::vector<Parameter> parameters;

@@ -3,6 +3,7 @@
 #include "plant_model/fmu/fmu.hpp"
 
 #include <dlfcn.h>
+#include <pthread.h>
 #include <setjmp.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -14,12 +15,16 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <atomic>
+#include <chrono>
 #include <mutex>
+#include <thread>
 #include <unordered_map>
 #include <string_view>
 
 #include <fmt/format.h>
 
+#include "common/duration.hpp"
 #include "common/yaml.hpp"
 
 namespace plcfi::plant::fmu {
@@ -52,6 +57,44 @@ thread_local FmuInstance* t_current = nullptr;
 std::mutex g_alloc_mutex;
 std::unordered_map<void*, const FmuInstance*> g_allocations;  // live block -> the instance it was made in
 
+// ---- hang watchdog ----
+// A thread that looks every 50 ms at the guarded call in progress (one per process: plcfi
+// drives its plant from one thread). A call that has not returned within its limit gets
+// kWatchdogSignal, whose handler jumps out of it like out of a crash. Each arming of the
+// guard has a generation: the handler acts only on the generation the watchdog fired at,
+// so a signal that arrives just after the call returned (or in the next call) is ignored.
+constexpr int kWatchdogSignal = SIGUSR2;
+std::atomic<uint64_t> g_generation{0};   // of the current arming (odd: armed)
+std::atomic<int64_t> g_armed_at{0};      // steady clock, ns
+std::atomic<int64_t> g_limit_ns{0};
+std::atomic<uint64_t> g_fired{0};        // the generation the watchdog signalled
+pthread_t g_guarded_thread;
+
+int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void watchdog_loop() {
+  for (;;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    const uint64_t gen = g_generation.load(std::memory_order_acquire);
+    if (!(gen & 1)) continue;  // no call in progress
+    const int64_t at = g_armed_at.load(std::memory_order_acquire);
+    const int64_t limit = g_limit_ns.load(std::memory_order_relaxed);
+    if (g_generation.load(std::memory_order_acquire) != gen || limit <= 0 || steady_ns() - at < limit) continue;
+    if (g_fired.exchange(gen) == gen) continue;  // signalled already
+    pthread_kill(g_guarded_thread, kWatchdogSignal);
+  }
+}
+
+void on_watchdog(int sig, siginfo_t*, void*) {
+  sigjmp_buf* b = t_guard;
+  if (!b || g_fired.load(std::memory_order_acquire) != g_generation.load(std::memory_order_acquire)) return;
+  t_guard = nullptr;
+  t_signal = sig;
+  siglongjmp(*b, 1);
+}
+
 void on_crash(int sig, siginfo_t*, void*) {
   if (sigjmp_buf* b = t_guard) {
     t_guard = nullptr;
@@ -80,6 +123,13 @@ void install_crash_guard() {
       sigemptyset(&sa.sa_mask);
       sigaction(sig, &sa, &g_previous[sig]);
     }
+    struct sigaction wa {};
+    wa.sa_sigaction = on_watchdog;
+    wa.sa_flags = SA_SIGINFO | SA_NODEFER | SA_RESTART;
+    sigemptyset(&wa.sa_mask);
+    sigaction(kWatchdogSignal, &wa, nullptr);
+    g_guarded_thread = pthread_self();
+    std::thread(watchdog_loop).detach();
   });
 }
 
@@ -341,6 +391,9 @@ fmi2Status FmuInstance::guarded(std::string_view call, F&& f) {
   // Inside batch() the guard is armed already: the call only names itself.
   if (t_guard && t_current == this) return f();
   t_current = this;
+  g_limit_ns.store(call_timeout_ns_, std::memory_order_relaxed);
+  g_armed_at.store(steady_ns(), std::memory_order_release);
+  g_generation.fetch_add(1, std::memory_order_acq_rel);  // odd: armed
   sigjmp_buf buf;
   // No signal mask saved (savemask 0): no system call per call. The handler runs with
   // SA_NODEFER, so nothing is left blocked when it jumps back here. After the jump only
@@ -348,14 +401,23 @@ fmi2Status FmuInstance::guarded(std::string_view call, F&& f) {
   if (sigsetjmp(buf, 0) != 0) crashed();
   t_guard = &buf;
   // Disarmed however f ends (a batch throws FmuError for a bad status): a crash later
-  // must never jump into this frame once it is gone.
-  struct Disarm {
-    ~Disarm() {
-      t_guard = nullptr;
-      t_current = nullptr;
-    }
-  } disarm;
-  return f();
+  // must never jump into this frame once it is gone. (No object with a destructor lives
+  // between here and the FMU's code: a jump back to sigsetjmp must skip none.)
+  fmi2Status s = fmi2OK;
+  try {
+    s = f();
+  } catch (...) {
+    disarm();
+    throw;
+  }
+  disarm();
+  return s;
+}
+
+void FmuInstance::disarm() {
+  t_guard = nullptr;
+  t_current = nullptr;
+  g_generation.fetch_add(1, std::memory_order_acq_rel);  // even: no call
 }
 
 void FmuInstance::batch(void (*fn)(void*), void* context) {
@@ -367,8 +429,11 @@ void FmuInstance::batch(void (*fn)(void*), void* context) {
 
 void FmuInstance::crashed() {
   dead_ = true;
-  t_current = nullptr;
+  disarm();
   const int sig = t_signal;
+  if (sig == kWatchdogSignal)
+    fail(current_call_, fmt::format("did not return within {} (the FMU hangs; call_timeout in the plant file sets the limit)",
+                                    common::format_duration(call_timeout_ns_)));
   fail(current_call_, fmt::format("crashed inside the FMU ({}, signal {})", strsignal(sig), sig));
 }
 

@@ -107,6 +107,10 @@ class FmuInstance {
   // (the per-step exchange of a plant: sets, steps and gets at the cost of one).
   void batch(void (*fn)(void*), void* context);
 
+  // How long one call (or one batch) may take before it counts as a hang and is broken
+  // off as an FmuError (the instance is dead then). 0: no limit.
+  void set_call_timeout(int64_t ns) { call_timeout_ns_ = ns; }
+
   // The last message the FMU logged (its logger callback), or "".
   const std::string& last_message() const { return last_message_; }
   // What messages name this FMU by: "FMU tank.fmu".
@@ -123,6 +127,7 @@ class FmuInstance {
   template <class F>
   fmi2Status guarded(std::string_view call, F&& f);
   [[noreturn]] void crashed();
+  static void disarm();
   [[noreturn]] void fail(std::string_view call, const std::string& what);
 
   static void* allocate(size_t count, size_t size);
@@ -139,6 +144,7 @@ class FmuInstance {
   bool initialized_ = false;  // past ExitInitializationMode: Terminate before Free
   std::string last_message_;
   std::string_view current_call_;
+  int64_t call_timeout_ns_ = 10'000'000'000;
 };
 
 }  // namespace plcfi::plant::fmu

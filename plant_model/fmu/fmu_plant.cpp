@@ -182,6 +182,7 @@ std::unique_ptr<FmuPlant> FmuPlant::create(const PlantFile& pf) {
   p->bool_buf_.assign(std::max({p->in_bool_.vr.size(), p->out_bool_.vr.size(), size_t{1}}), 0);
   p->values_.assign(p->signals_.size(), 0.0);
   p->instance_ = std::make_unique<FmuInstance>(*p->archive_, std::filesystem::path(pf.fmu).stem().string());
+  p->instance_->set_call_timeout(pf.call_timeout_ns);
   p->initialize();
   return p;
 }

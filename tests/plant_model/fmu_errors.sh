@@ -45,6 +45,8 @@ plant probe.fmu "parameters: {FailAt: 1.5}"
 sim "fmi2DoStep(t = 1.5 s, h = 0.01 s) returned fmi2Error (the FMU logged: step failed at t = 1.5"
 plant probe.fmu "parameters: {CrashAt: 0.5}"
 sim "fmi2DoStep crashed inside the FMU (Segmentation fault, signal 11)"
+plant probe.fmu $'call_timeout: 500ms\nparameters: {HangAt: 0.5}'
+sim "fmi2DoStep did not return within 500ms (the FMU hangs; call_timeout in the plant file sets the limit)"
 plant probe.fmu "parameters: {EndAt: 2.5}"
 sim "returned fmi2Discard: the FMU ended its simulation at t = 2.5 s (its DefaultExperiment stopTime is 10 s)"
 plant probe.fmu "parameters: {NeedStopTime: true}"
@@ -52,7 +54,7 @@ sim "probe needs a stop time"
 plant probe.fmu $'stop_time: 2s\nparameters: {NeedStopTime: true}'
 sim "goes past the stop time 2"
 plant probe.fmu "parameters: {Speed: 1}"
-sim "$work/p.yaml:3:21: the FMU has no variable 'Speed' (its parameters: TogglePeriod, FailAt, CrashAt, EndAt, NeedStopTime, InternalStep)"
+sim "$work/p.yaml:3:21: the FMU has no variable 'Speed' (its parameters: TogglePeriod, FailAt, CrashAt, EndAt, NeedStopTime, InternalStep, HangAt)"
 plant probe.fmu "stop_time: soon"
 sim "$work/p.yaml:3:12: stop_time: expected a duration, got 'soon'"
 

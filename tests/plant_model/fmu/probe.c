@@ -12,12 +12,13 @@
      Integer  1 Steps         output: fmi2DoStep calls that advanced the time
      Real     1 Ramp          output: t
              10 TogglePeriod (s)   11 FailAt (s)   12 CrashAt (s)   13 EndAt (s)
-             14 InternalStep (s)                                   (fixed parameters)
+             14 InternalStep (s)   15 HangAt (s)                   (fixed parameters)
 
    Failures (a negative time means never; "a step passes T" means it would end after T):
    - FailAt: a step that passes FailAt returns fmi2Error, logs "step failed at t = ..."
      with the step's start, and the time stays there;
    - CrashAt: a step that passes CrashAt writes through a NULL pointer (SIGSEGV);
+   - HangAt: a step that passes HangAt never returns (an endless loop);
    - EndAt: a step that passes EndAt advances to EndAt only and returns fmi2Discard; then
      fmi2GetBooleanStatus(fmi2Terminated) is fmi2True and
      fmi2GetRealStatus(fmi2LastSuccessfulTime) is EndAt;
@@ -40,6 +41,7 @@ typedef struct {
   double fail_at;
   double crash_at;
   double end_at;
+  double hang_at;
   double internal_step;
   int need_stop_time;
   /* outputs */
@@ -62,6 +64,7 @@ static const FmuVariable kVariables[] = {
     VAR("EndAt", FMU_REAL, 13, FMU_PARAMETER, end_at, FMU_ANY),
     VAR("NeedStopTime", FMU_BOOLEAN, 10, FMU_PARAMETER, need_stop_time, FMU_ANY),
     VAR("InternalStep", FMU_REAL, 14, FMU_PARAMETER, internal_step, FMU_NON_NEGATIVE),
+    VAR("HangAt", FMU_REAL, 15, FMU_PARAMETER, hang_at, FMU_ANY),
 };
 
 static void defaults(Fmu* f) {
@@ -71,6 +74,7 @@ static void defaults(Fmu* f) {
   m->fail_at = -1.0;
   m->crash_at = -1.0;
   m->end_at = -1.0;
+  m->hang_at = -1.0;
   m->internal_step = 0.0;
   m->need_stop_time = 0;
 }
@@ -110,7 +114,14 @@ static void crash(void) {
   *null_pointer = 1;
 }
 
-typedef enum { NONE, CRASH, FAIL, STOP, END } Event;
+/* The hang of HangAt: an endless loop the compiler must keep (a volatile read each turn). */
+static void hang(void) {
+  volatile int spin = 1;
+  while (spin) {
+  }
+}
+
+typedef enum { NONE, CRASH, HANG, FAIL, STOP, END } Event;
 
 static fmi2Status do_step(Fmu* f, double h) {
   Probe* m = f->data;
@@ -127,6 +138,7 @@ static fmi2Status do_step(Fmu* f, double h) {
     double time;
   } candidates[] = {
       {CRASH, m->crash_at >= 0.0, m->crash_at},
+      {HANG, m->hang_at >= 0.0, m->hang_at},
       {FAIL, m->fail_at >= 0.0, m->fail_at},
       {STOP, m->need_stop_time && f->stop_time_defined, f->stop_time},
       {END, m->end_at >= 0.0, m->end_at},
@@ -141,6 +153,9 @@ static fmi2Status do_step(Fmu* f, double h) {
     case CRASH:
       fmu_log(f, fmi2OK, "crashing at t = %g (CrashAt %g)", t0, m->crash_at); /* seen with debug logging */
       crash();
+      return fmi2Fatal; /* not reached */
+    case HANG:
+      hang();
       return fmi2Fatal; /* not reached */
     case FAIL:
       fmu_log(f, fmi2Error, "step failed at t = %g (FailAt %g)", t0, m->fail_at);

@@ -279,6 +279,8 @@ TEST_F(FmuPlantTest, FailuresInTheRunNameTheCallAndTheTime) {
   EXPECT_NE(e.find("returned fmi2Discard: the FMU ended its simulation at t = 0.3 s"), std::string::npos) << e;
   e = run_until_error("parameters: {CrashAt: 0.2}\n", 1);
   EXPECT_NE(e.find("fmi2DoStep crashed inside the FMU (Segmentation fault, signal 11)"), std::string::npos) << e;
+  e = run_until_error("call_timeout: 300ms\nparameters: {HangAt: 0.3}\n", 1);
+  EXPECT_NE(e.find("fmi2DoStep did not return within 300ms (the FMU hangs"), std::string::npos) << e;
   e = run_until_error("stop_time: 0.4s\nparameters: {NeedStopTime: true}\n", 1);
   EXPECT_NE(e.find("goes past the stop time"), std::string::npos) << e;
   e = run_until_error("parameters: {NeedStopTime: true}\n", 1);
