@@ -11,6 +11,13 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/plcfi_readme_XXXXXX")
 trap 'kill $(jobs -p) 2>/dev/null; rm -rf "$work"' EXIT
 (cd "$src" && git ls-files -z 2>/dev/null | xargs -0 cp --parents -t "$work" 2>/dev/null) || cp -r "$src"/. "$work"
 [[ -f "$work/README.md" ]] || { echo "cannot copy the repository"; exit 1; }
+# README's bench examples serve on 127.0.0.1:1502 and :1503. In the copy they move to free
+# ports, so that two runs of this test on one machine (two clones' CI) cannot collide.
+free_port() { /usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
+p1=$(free_port)
+p2=$(free_port)
+while [[ $p2 == "$p1" ]]; do p2=$(free_port); done
+grep -rlZ -e "127.0.0.1:1502" -e "127.0.0.1:1503" "$work" | xargs -0 -r sed -i "s/127\.0\.0\.1:1502/127.0.0.1:$p1/g; s/127\.0\.0\.1:1503/127.0.0.1:$p2/g"
 mkdir -p "$work/.bin"
 ln -s "$plcfi" "$work/.bin/plcfi"
 export PATH="$work/.bin:$PATH"
