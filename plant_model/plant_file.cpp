@@ -56,12 +56,23 @@ std::string scalar_text(const YamlDoc& doc, const YAML::Node& n, const std::stri
 
 }  // namespace
 
+void check_binding(const MapEntry& m, ValueKind kind, const std::string& what) {
+  const char area = m.input ? 'I' : 'Q';
+  auto fail = [](const std::string& where, const std::string& message) { throw common::InputError(where + ": " + message); };
+  if (kind == ValueKind::Bool && !m.bit)
+    fail(m.where, fmt::format("'{}' is {}: map it to a bit (%{}X...), not {}", m.plant, what, area, m.image));
+  if (kind != ValueKind::Bool && m.bit)
+    fail(m.where, fmt::format("'{}' is {}: map it to a word (%{}W...), not the bit {}", m.plant, what, area, m.image));
+  if (kind == ValueKind::Real && !m.scale)
+    fail(m.where, fmt::format("'{}' is {}: a word needs scale: {{from: [low, high], to: [low, high]}} (plant units to "
+                              "image units, e.g. to: [0, 27648])",
+                              m.plant, what));
+  if (kind != ValueKind::Real && m.scale)
+    fail(m.scale_where, fmt::format("scale: '{}' is {}; only a real-valued variable is scaled", m.plant, what));
+}
+
 bool is_plant_file(const std::string& arg) {
-  auto ends = [&](const char* suffix) {
-    std::string s(suffix);
-    return arg.size() > s.size() && arg.compare(arg.size() - s.size(), s.size(), s) == 0;
-  };
-  return ends(".yaml") || ends(".yml");
+  return arg.ends_with(".yaml") || arg.ends_with(".yml");
 }
 
 PlantFile read_plant_file(const std::string& path) {

@@ -72,6 +72,14 @@ struct PlantFile {
   std::string where;                // FILE:1:1, for messages about the file as a whole
 };
 
+// What a plant variable holds, for the check of its map entry.
+enum class ValueKind { Bool, Integer, Real };
+// Checks that map entry `m` fits a plant variable of `kind` (a Bool on a bit, an Integer
+// or Real on a word, scale exactly for a Real); `what` names the variable's type in the
+// message ("Boolean (x.fmu/modelDescription.xml:12:5)", "INT"). Throws common::InputError
+// at the entry's line and column. The one rule for FMU, ST and remapped built-in plants.
+void check_binding(const MapEntry& m, ValueKind kind, const std::string& what);
+
 // Reads and checks a plant file. Throws common::InputError ("FILE:LINE:COL: message").
 PlantFile read_plant_file(const std::string& path);
 

@@ -84,19 +84,11 @@ std::unique_ptr<FmuPlant> FmuPlant::create(const PlantFile& pf) {
     if (v->type == VarType::String || v->type == VarType::Enumeration)
       fail_at(m.plant_where, fmt::format("'{}' is a {} variable ({}:{}:{}): the map takes Real, Integer and Boolean",
                                          m.plant, type_name(v->type), fmu_md, v->line, v->col));
-    if (v->type == VarType::Boolean && !m.bit)
-      fail_at(m.where, fmt::format("'{}' is Boolean ({}:{}:{}): map it to a bit (%{}X...), not {}", m.plant, fmu_md,
-                                   v->line, v->col, m.input ? 'I' : 'Q', m.image));
-    if (v->type != VarType::Boolean && m.bit)
-      fail_at(m.where, fmt::format("'{}' is {} ({}:{}:{}): map it to a word (%{}W...), not the bit {}", m.plant,
-                                   type_name(v->type), fmu_md, v->line, v->col, m.input ? 'I' : 'Q', m.image));
-    if (v->type == VarType::Real && !m.scale)
-      fail_at(m.where, fmt::format("'{}' is Real ({}:{}:{}): a word needs scale: {{from: [low, high], to: [low, high]}} "
-                                   "(plant units to image units, e.g. to: [0, 27648])",
-                                   m.plant, fmu_md, v->line, v->col));
-    if (v->type != VarType::Real && m.scale)
-      fail_at(m.scale_where, fmt::format("scale: '{}' is {} ({}:{}:{}); only a Real variable is scaled", m.plant,
-                                         type_name(v->type), fmu_md, v->line, v->col));
+    check_binding(m,
+                  v->type == VarType::Boolean   ? ValueKind::Bool
+                  : v->type == VarType::Integer ? ValueKind::Integer
+                                                : ValueKind::Real,
+                  fmt::format("{} ({}:{}:{})", type_name(v->type), fmu_md, v->line, v->col));
 
     SignalInfo s;
     s.name = m.plant;

@@ -96,27 +96,32 @@ class Reader {
   mutable uint32_t line_ = 1, col_ = 1;
 };
 
+// An enumerated attribute: one of `names` (with `dflt` when absent), else an error listing them.
+template <class E, size_t N>
+E parse_choice(const Reader& r, const pugi::xml_node& n, const char* attr, const char* dflt,
+               const std::pair<const char*, E> (&names)[N]) {
+  std::string_view v = n.attribute(attr) ? n.attribute(attr).value() : dflt;
+  std::string list;
+  for (size_t i = 0; i < N; ++i) {
+    if (v == names[i].first) return names[i].second;
+    list += std::string(i == 0 ? "" : i + 1 == N ? " or " : ", ") + names[i].first;
+  }
+  r.fail(n, fmt::format("ScalarVariable {}: expected {}, got '{}'", attr, list, v));
+}
+
 Causality parse_causality(const Reader& r, const pugi::xml_node& n) {
-  std::string_view v = n.attribute("causality") ? n.attribute("causality").value() : "local";
-  if (v == "parameter") return Causality::Parameter;
-  if (v == "calculatedParameter") return Causality::CalculatedParameter;
-  if (v == "input") return Causality::Input;
-  if (v == "output") return Causality::Output;
-  if (v == "local") return Causality::Local;
-  if (v == "independent") return Causality::Independent;
-  r.fail(n, fmt::format("ScalarVariable causality: expected parameter, calculatedParameter, input, output, local "
-                        "or independent, got '{}'",
-                        v));
+  static constexpr std::pair<const char*, Causality> kNames[] = {
+      {"parameter", Causality::Parameter}, {"calculatedParameter", Causality::CalculatedParameter},
+      {"input", Causality::Input},         {"output", Causality::Output},
+      {"local", Causality::Local},         {"independent", Causality::Independent}};
+  return parse_choice(r, n, "causality", "local", kNames);
 }
 
 Variability parse_variability(const Reader& r, const pugi::xml_node& n) {
-  std::string_view v = n.attribute("variability") ? n.attribute("variability").value() : "continuous";
-  if (v == "constant") return Variability::Constant;
-  if (v == "fixed") return Variability::Fixed;
-  if (v == "tunable") return Variability::Tunable;
-  if (v == "discrete") return Variability::Discrete;
-  if (v == "continuous") return Variability::Continuous;
-  r.fail(n, fmt::format("ScalarVariable variability: expected constant, fixed, tunable, discrete or continuous, got '{}'", v));
+  static constexpr std::pair<const char*, Variability> kNames[] = {
+      {"constant", Variability::Constant}, {"fixed", Variability::Fixed},         {"tunable", Variability::Tunable},
+      {"discrete", Variability::Discrete}, {"continuous", Variability::Continuous}};
+  return parse_choice(r, n, "variability", "continuous", kNames);
 }
 
 void check_start(const Reader& r, const pugi::xml_node& n, const ScalarVariable& v) {

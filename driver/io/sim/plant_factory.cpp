@@ -52,11 +52,9 @@ std::unique_ptr<plant::Plant> open_builtin(const plant::PlantFile& pf) {
     if ((it->dir == plant::Direction::FromPlant) != m.input)
       throw common::InputError(fmt::format("{}: '{}' is {} of {}: it belongs in {}", m.where, m.plant,
                                            m.input ? "an actuator" : "a sensor", pf.builtin, m.input ? "%Q" : "%I"));
-    if ((it->kind == plant::SignalKind::Bool) != m.bit)
-      throw common::InputError(fmt::format("{}: '{}' is {}: map it to {}", m.where, m.plant,
-                                           m.bit ? "analog" : "a BOOL", m.bit ? "a word" : "a bit"));
-    if (m.scale)
-      throw common::InputError(m.scale_where + ": scale: a built-in plant's analog signals are in image units already");
+    const bool bit = it->kind == plant::SignalKind::Bool;
+    plant::check_binding(m, bit ? plant::ValueKind::Bool : plant::ValueKind::Integer,
+                         bit ? "a BOOL signal" : "an analog signal in image units");
     it->address = m.image;
     it->where = m.where;
   }
@@ -68,14 +66,11 @@ std::unique_ptr<plant::Plant> open_builtin(const plant::PlantFile& pf) {
 std::unique_ptr<plant::Plant> open_plant(const std::string& name_or_file, const std::string& config_path,
                                          std::string* err) {
   if (!plant::is_plant_file(name_or_file)) {
-    auto ends = [&](const char* suffix) {
-      const std::string s(suffix);
-      return name_or_file.size() > s.size() && name_or_file.compare(name_or_file.size() - s.size(), s.size(), s) == 0;
-    };
-    if (ends(".fmu") || ends(".st")) {
+    const bool fmu = name_or_file.ends_with(".fmu");
+    if (fmu || name_or_file.ends_with(".st")) {
       *err = fmt::format("{}: an {} plant is named by a plant file (YAML: {}: {}, its step and the map onto the image; "
                          "see README, 'Your own plant')",
-                         name_or_file, ends(".fmu") ? "FMU" : "ST", ends(".fmu") ? "fmu" : "st", name_or_file);
+                         name_or_file, fmu ? "FMU" : "ST", fmu ? "fmu" : "st", name_or_file);
       return nullptr;
     }
     return plant::make_plant(name_or_file, config_path, err);

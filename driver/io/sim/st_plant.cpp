@@ -74,16 +74,11 @@ std::unique_ptr<StPlant> StPlant::create(const plant::PlantFile& pf) {
     else if (is_integer(k)) b.kind = Kind::Int;
     else if (k == st::TypeKind::Real || k == st::TypeKind::LReal) b.kind = Kind::Real;
     else fail_at(m.plant_where, fmt::format("'{}' is of type {}: the map takes BOOL, integers, REAL and LREAL", m.plant, b.var.type->name));
-    if (b.kind == Kind::Bool && !m.bit)
-      fail_at(m.where, fmt::format("'{}' is BOOL: map it to a bit (%{}X...), not {}", m.plant, m.input ? 'I' : 'Q', m.image));
-    if (b.kind != Kind::Bool && m.bit)
-      fail_at(m.where, fmt::format("'{}' is {}: map it to a word (%{}W...), not the bit {}", m.plant, b.var.type->name,
-                                   m.input ? 'I' : 'Q', m.image));
-    if (b.kind == Kind::Real && !m.scale)
-      fail_at(m.where, fmt::format("'{}' is {}: a word needs scale: {{from: [low, high], to: [low, high]}}", m.plant,
-                                   b.var.type->name));
-    if (b.kind != Kind::Real && m.scale)
-      fail_at(m.scale_where, fmt::format("scale: '{}' is {}; only REAL and LREAL variables are scaled", m.plant, b.var.type->name));
+    check_binding(m,
+                  b.kind == Kind::Bool  ? plant::ValueKind::Bool
+                  : b.kind == Kind::Int ? plant::ValueKind::Integer
+                                        : plant::ValueKind::Real,
+                  b.var.type->name);
     b.scale = m.scale;
     plant::SignalInfo s;
     s.name = m.plant;

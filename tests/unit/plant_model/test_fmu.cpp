@@ -260,6 +260,46 @@ TEST_F(FmuPlantTest, BrokenArchivesArePreciseErrors) {
   }
 }
 
+TEST_F(FmuPlantTest, ADirectoryOrADeviceAsTheFmuIsAnErrorAtOnce) {
+  std::string err;
+  for (const std::string& target : {dir_.string(), std::string("/dev/zero")}) {
+    const std::string p = write("d.yaml", "fmu: " + target + "\nstep: 10ms\nmap:\n  - {image: \"%IX0.0\", plant: Toggle}\n");
+    EXPECT_FALSE(open(p, &err)) << target;
+    EXPECT_EQ(err.rfind(p + ":1:6: fmu: " + target + ": ", 0), 0u) << err;
+  }
+  EXPECT_NE(err.find("not a regular file"), std::string::npos) << err;
+}
+
+TEST_F(FmuPlantTest, ABuiltInPlantCanBeMappedOntoOtherAddresses) {
+  const std::string p = write("b.yaml", "builtin: stamping\nmap:\n  - {image: \"%IX4.0\", plant: PosCrane}\n"
+                                        "  - {image: \"%QW8\", plant: PressureSetpoint}\n");
+  std::string err;
+  auto plant = open(p, &err);
+  ASSERT_TRUE(plant) << err;
+  for (const auto& s : plant->signals()) {
+    if (s.name == "PosCrane") {
+      EXPECT_EQ(s.address, "%IX4.0");
+    } else if (s.name == "PressureSetpoint") {
+      EXPECT_EQ(s.address, "%QW8");
+    } else if (s.name == "PosStamp") {
+      EXPECT_EQ(s.address, "%IX0.1");  // not in the map: its own address
+    }
+  }
+  auto error = [&](const std::string& map) {
+    std::string e;
+    EXPECT_FALSE(open(write("e.yaml", "builtin: stamping\nmap:\n" + map), &e));
+    return e;
+  };
+  const std::string e = (dir_ / "e.yaml").string();
+  EXPECT_EQ(error("  - {image: \"%IX4.0\", plant: Nope}\n").rfind(e + ":3:30: the plant stamping has no signal 'Nope'", 0), 0u);
+  EXPECT_EQ(error("  - {image: \"%QX4.0\", plant: PosCrane}\n"),
+            e + ":3:5: 'PosCrane' is a sensor of stamping: it belongs in %I");
+  EXPECT_EQ(error("  - {image: \"%IW4\", plant: PosCrane}\n"),
+            e + ":3:5: 'PosCrane' is a BOOL signal: map it to a bit (%IX...), not %IW4");
+  EXPECT_EQ(error("  - {image: \"%IW4\", plant: StampPressure, scale: {from: [0, 1], to: [0, 10]}}\n"),
+            e + ":3:50: scale: 'StampPressure' is an analog signal in image units; only a real-valued variable is scaled");
+}
+
 TEST_F(FmuPlantTest, FailuresInTheRunNameTheCallAndTheTime) {
   auto run_until_error = [&](const std::string& params, double seconds) -> std::string {
     std::string err;
