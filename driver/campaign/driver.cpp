@@ -113,7 +113,9 @@ class PassiveDriver final : public rt::ScanHooks {
     active_ = SIZE_MAX;
     done_ = false;
     injected_ = false;
+    claimed_ = false;
   }
+  bool claimed() const { return claimed_; }
   bool done() const { return done_; }
   const std::string& error() const { return error_; }
   bool injected() const { return injected_; }
@@ -131,13 +133,16 @@ class PassiveDriver final : public rt::ScanHooks {
       uint8_t now = pre[i];
       bool rose = now && !prev_[i];
       prev_[i] = now;
-      if (!rose || active_ != SIZE_MAX || paths_[i] >= cb_.spec.max_paths) continue;
+      if (!rose || active_ != SIZE_MAX || claimed_ || paths_[i] >= cb_.spec.max_paths) continue;
       if (!probed) {
         path_of_scan(r);
         probed = true;
       }
       if (tested_.count({i, hash_})) continue;
-      inject(r, i);
+      if (opt_.share_n > 1 && run_ % static_cast<uint64_t>(opt_.share_n) != static_cast<uint64_t>(opt_.share_k))
+        claim(r, i);
+      else
+        inject(r, i);
     }
   }
 
@@ -224,6 +229,23 @@ class PassiveDriver final : public rt::ScanHooks {
     hash_ = h;
   }
 
+  // A run of another share: the case and path are taken, as the injection would take
+  // them, and the run ends here; its test is another process's.
+  void claim(rt::Runtime& r, size_t i) {
+    const TestCase& tc = cb_.cases[i];
+    ++paths_[i];
+    tested_.insert({i, hash_});
+    exec_ = Execution{};
+    exec_.case_id = tc.id;
+    exec_.case_index = i;
+    exec_.path = paths_[i];
+    exec_.path_hash = hash_;
+    exec_.branches = branches_;
+    exec_.run = run_;
+    exec_.inject_ns = r.now();
+    injected_ = claimed_ = done_ = true;
+  }
+
   void inject(rt::Runtime& r, size_t i) {
     const TestCase& tc = cb_.cases[i];
     faults::InjectionContext ctx;
@@ -306,7 +328,7 @@ class PassiveDriver final : public rt::ScanHooks {
   uint64_t hash_ = 0;
   uint64_t run_ = 0;
   size_t active_ = SIZE_MAX;
-  bool done_ = false, injected_ = false;
+  bool done_ = false, injected_ = false, claimed_ = false;
   uint64_t state_ = 0;
   std::unique_ptr<monitor::MonitorSet> monitors_;
   std::unique_ptr<report::TraceWriter> trace_;
@@ -341,21 +363,11 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
   runtime.add_hooks(&driver);
 
   Journal journal;
-  std::string fingerprint = campaign_fingerprint(cb);
+  const bool shared = static_cast<bool>(opt.on_run);  // a share of the runs: records, no journal
   Progress pr;
   pr.cases = cb.cases.size();
-  if (!opt.out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(opt.out_dir, ec);
-    if (ec) {
-      *err = opt.out_dir + ": cannot create the output folder: " + ec.message();
-      return false;
-    }
-    std::string path = (std::filesystem::path(opt.out_dir) / "results.jsonl").string();
-    JournalState st;
-    journal.set_plant(c.plant);
-    if (!journal.open(path, opt.resume, c.name, fingerprint, cb.cases, &st, err)) return false;
-    for (auto& e : st.executions) {
+  auto adopt = [&](const JournalState& st) {
+    for (const auto& e : st.executions) {
       driver.mark_tested(e);
       ++(e.outcome == Outcome::Pass ? pr.pass : pr.fail);
       out->executions.push_back(e);
@@ -364,7 +376,23 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
     pr.run = st.next_run;
     pr.campaign_ns = st.campaign_ns;
     pr.scans = st.scans;
+  };
+  if (!opt.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(opt.out_dir, ec);
+    if (ec) {
+      *err = opt.out_dir + ": cannot create the output folder: " + ec.message();
+      return false;
+    }
+    if (!shared) {
+      std::string path = (std::filesystem::path(opt.out_dir) / "results.jsonl").string();
+      JournalState st;
+      journal.set_plant(c.plant);
+      if (!journal.open(path, opt.resume, c.name, campaign_fingerprint(cb), cb.cases, &st, err)) return false;
+      adopt(st);
+    }
   }
+  if (shared && opt.resumed) adopt(*opt.resumed);
   pr.executions = out->executions.size();
 
   int64_t next_progress = pr.campaign_ns + 1'000'000'000;
@@ -382,6 +410,8 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
     else runtime.cold_restart(seed);
     driver.begin_run(pr.run);
     bool search_over = false;
+    RunRecord rec;  // what a share of the runs reports of this one
+    rec.run = pr.run;
     while (!driver.done()) {
       if (rt::LoopEnd end = loop.check_stop(); end != rt::LoopEnd::None) {
         out->end_reason = end == rt::LoopEnd::Signal ? "interrupted by a signal" : loop.end_reason();
@@ -391,7 +421,11 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
       const int64_t before = runtime.now();
       loop.scan();
       ++pr.scans;
-      pr.campaign_ns += runtime.now() - before;  // one tick, or more after an overrun on the bench
+      const int64_t dt = runtime.now() - before;  // one tick, or more after an overrun on the bench
+      pr.campaign_ns += dt;
+      ++rec.scans;
+      rec.ns += dt;
+      if (rec.inject_scan == 0 && driver.injected()) rec.inject_scan = rec.scans;
       if (!driver.active()) {
         // Not testing: the run searches for a precondition on an untested path.
         if (runtime.now() >= c.search_window_ns || runtime.stopped()) {
@@ -411,6 +445,16 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
       *err = "internal error: " + driver.error();
       return false;
     }
+    if (driver.done() && driver.claimed()) {  // another share tests this run
+      ++pr.run;
+      rec.kind = RunRecord::Kind::Claimed;
+      rec.exec = driver.result();
+      if (!opt.on_run(rec)) {
+        out->end_reason = "stopped by the caller";
+        break;
+      }
+      continue;
+    }
     if (driver.done()) {
       Execution e = driver.result();
       ++(e.outcome == Outcome::Pass ? pr.pass : pr.fail);
@@ -420,9 +464,26 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
       if (journal.is_open() && !journal.append(e, pr, err)) return false;
       out->executions.push_back(e);
       if (opt.on_verdict) opt.on_verdict(e, pr);
+      if (shared) {
+        rec.kind = RunRecord::Kind::Executed;
+        rec.line = journal_line(e, cb.cases[e.case_index], Progress{});
+        rec.exec = std::move(e);
+        if (!opt.on_run(rec)) {
+          out->end_reason = "stopped by the caller";
+          break;
+        }
+      }
       continue;
     }
     ++pr.run;
+    if (shared) {
+      rec.kind = RunRecord::Kind::Ended;
+      rec.end = !search_over ? "budget" : runtime.stopped() ? "stopped: " + runtime.stop_reason() : "window";
+      if (!opt.on_run(rec)) {
+        out->end_reason = "stopped by the caller";
+        break;
+      }
+    }
     if (search_over) {
       out->end_reason = runtime.stopped() ? "the program stopped outside a test: " + runtime.stop_reason()
                                           : fmt::format("no untested case or path within the search window of {}",

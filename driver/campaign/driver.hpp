@@ -14,6 +14,7 @@
 
 #include "execution.hpp"
 #include "generate.hpp"
+#include "journal.hpp"
 #include "native/native.hpp"
 #include "runtime/backend.hpp"
 #include "runtime/realtime.hpp"
@@ -33,6 +34,12 @@ struct DriverOptions {
   std::function<std::string()> io_lost;
   std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
   const st::NativeCode* native = nullptr;  // run program, preconditions and monitors natively
+  // A share of the runs (parallel.hpp): runs r with r % share_n == share_k are tested, the
+  // others end at their injection. on_run gets every run's record in run order (false:
+  // stop); with on_run set, no journal is written here (VCDs are, for the own runs).
+  int share_k = 0, share_n = 1;
+  std::function<bool(const RunRecord&)> on_run;
+  const JournalState* resumed = nullptr;  // with on_run: start from this journal state
 };
 
 struct CampaignResult {

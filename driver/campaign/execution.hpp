@@ -31,6 +31,22 @@ struct Execution {
   std::string vcd;                 // trace of the test window (file name in the output folder)
 };
 
+// One run of a campaign as a worker process or a shard saw it (parallel.hpp). A process
+// running a share of the runs searches in every run (which case a run injects does not
+// depend on earlier tests' outcomes) but tests only its own runs; a run of another share
+// ends at its injection, with the case claimed.
+struct RunRecord {
+  enum class Kind { Executed, Claimed, Ended };
+  Kind kind = Kind::Ended;
+  uint64_t run = 0;
+  Execution exec;            // Executed: the execution; Claimed: case, path, hash, branches, inject_ns
+  std::string line;          // Executed: its journal line, with campaign_ns and scans still 0
+  uint64_t scans = 0;        // scans of the run as this process ran it
+  int64_t ns = 0;            // their scan-clock time
+  uint64_t inject_scan = 0;  // the scan (1-based) whose before_scan injected or claimed; 0: none
+  std::string end;           // Ended: "window", "budget" or "stopped: <reason>"
+};
+
 struct Progress {
   uint64_t run = 0, scans = 0;
   int64_t campaign_ns = 0;  // scan-clock time used, all runs

@@ -52,6 +52,59 @@ std::string journal_line(const Execution& e, const TestCase& tc, const Progress&
   return common::json_compact(j);
 }
 
+std::string journal_header(const std::string& campaign, const std::string& plant, const std::string& fingerprint,
+                           size_t cases) {
+  Json head;
+  head["journal"] = "plcfi campaign";
+  head["campaign"] = campaign;
+  if (!plant.empty()) head["plant"] = plant;
+  head["fingerprint"] = fingerprint;
+  head["cases"] = cases;
+  return common::json_compact(head);
+}
+
+bool parse_execution(const common::Json& o, const std::vector<TestCase>& cases, Execution* out, std::string* why) {
+  Execution e;
+  const std::string* id = get_str(o, "case");
+  const std::string* verdict = get_str(o, "verdict");
+  const std::string* hash = get_str(o, "path_hash");
+  if (!id || !verdict || !hash) {
+    *why = "journal line lacks case, verdict or path_hash";
+    return false;
+  }
+  e.case_id = *id;
+  e.case_index = SIZE_MAX;
+  for (size_t i = 0; i < cases.size(); ++i)
+    if (cases[i].id == *id) e.case_index = i;
+  if (e.case_index == SIZE_MAX) {
+    *why = fmt::format("unknown case '{}'", *id);
+    return false;
+  }
+  e.outcome = *verdict == "PASS" ? Outcome::Pass : Outcome::Fail;
+  try {
+    size_t used = 0;
+    e.path_hash = std::stoull(*hash, &used, 16);
+    if (used != hash->size()) throw std::invalid_argument(*hash);
+  } catch (const std::exception&) {
+    *why = fmt::format("path_hash '{}' is not hexadecimal", *hash);
+    return false;
+  }
+  int64_t v = 0;
+  if (get_int(o, "path", &v)) e.path = static_cast<int>(v);
+  if (auto it = o.find("branches"); it != o.end() && it->is_array())
+    for (const auto& b : *it)
+      if (b.is_number_integer()) e.branches.push_back(b.get<uint32_t>());
+  if (const std::string* s = get_str(o, "reason")) e.reason = *s;
+  if (const std::string* s = get_str(o, "vcd")) e.vcd = *s;
+  std::pair<const char*, int64_t*> ints[] = {{"inject_ns", &e.inject_ns}, {"start_ns", &e.start_ns},
+                                             {"reaction_ns", &e.reaction_ns}, {"end_ns", &e.end_ns},
+                                             {"latency_ns", &e.latency_ns}};
+  for (auto& [k, dst] : ints) get_int(o, k, dst);
+  if (get_int(o, "run", &v)) e.run = static_cast<uint64_t>(v);
+  *out = std::move(e);
+  return true;
+}
+
 Journal::~Journal() {
   if (f_) std::fclose(f_);
 }
@@ -69,13 +122,7 @@ bool Journal::open(const std::string& path, bool resume, const std::string& camp
                    const std::vector<TestCase>& cases, JournalState* state, std::string* err) {
   path_ = path;
   cases_ = &cases;
-  Json head;
-  head["journal"] = "plcfi campaign";
-  head["campaign"] = campaign;
-  if (!plant_.empty()) head["plant"] = plant_;
-  head["fingerprint"] = fingerprint;
-  head["cases"] = cases.size();
-  const std::string header = common::json_compact(head);
+  const std::string header = journal_header(campaign, plant_, fingerprint, cases.size());
   std::error_code ec;
   if (resume && std::filesystem::exists(path, ec)) {
     std::string text;
@@ -118,42 +165,11 @@ bool Journal::open(const std::string& path, bool resume, const std::string& camp
         continue;
       }
       Execution e;
-      const std::string* id = get_str(o, "case");
-      const std::string* verdict = get_str(o, "verdict");
-      const std::string* hash = get_str(o, "path_hash");
-      if (!id || !verdict || !hash) {
-        *err = fmt::format("{}:{}:1: journal line lacks case, verdict or path_hash", path, n);
-        return false;
-      }
-      e.case_id = *id;
-      e.case_index = SIZE_MAX;
-      for (size_t i = 0; i < cases.size(); ++i)
-        if (cases[i].id == *id) e.case_index = i;
-      if (e.case_index == SIZE_MAX) {
-        *err = fmt::format("{}:{}:1: unknown case '{}'", path, n, *id);
-        return false;
-      }
-      e.outcome = *verdict == "PASS" ? Outcome::Pass : Outcome::Fail;
-      try {
-        size_t used = 0;
-        e.path_hash = std::stoull(*hash, &used, 16);
-        if (used != hash->size()) throw std::invalid_argument(*hash);
-      } catch (const std::exception&) {
-        *err = fmt::format("{}:{}:1: path_hash '{}' is not hexadecimal", path, n, *hash);
+      if (!parse_execution(o, cases, &e, &why)) {
+        *err = fmt::format("{}:{}:1: {}", path, n, why);
         return false;
       }
       int64_t v = 0;
-      if (get_int(o, "path", &v)) e.path = static_cast<int>(v);
-      if (auto it = o.find("branches"); it != o.end() && it->is_array())
-        for (const auto& b : *it)
-          if (b.is_number_integer()) e.branches.push_back(b.get<uint32_t>());
-      if (const std::string* s = get_str(o, "reason")) e.reason = *s;
-      if (const std::string* s = get_str(o, "vcd")) e.vcd = *s;
-      std::pair<const char*, int64_t*> ints[] = {{"inject_ns", &e.inject_ns}, {"start_ns", &e.start_ns},
-                                                 {"reaction_ns", &e.reaction_ns}, {"end_ns", &e.end_ns},
-                                                 {"latency_ns", &e.latency_ns}};
-      for (auto& [k, dst] : ints) get_int(o, k, dst);
-      if (get_int(o, "run", &v)) e.run = static_cast<uint64_t>(v);
       state->executions.push_back(e);
       state->next_run = e.run + 1;
       get_int(o, "campaign_ns", &state->campaign_ns);
@@ -185,6 +201,8 @@ bool Journal::open(const std::string& path, bool resume, const std::string& camp
   }
   return write_line(header, err);
 }
+
+bool Journal::append_line(const std::string& line, std::string* err) { return write_line(line, err); }
 
 bool Journal::append(const Execution& e, const Progress& p, std::string* err) {
   return write_line(journal_line(e, (*cases_)[e.case_index], p), err);

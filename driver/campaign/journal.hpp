@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/json.hpp"
 #include "execution.hpp"
 #include "generate.hpp"
 
@@ -39,6 +40,8 @@ class Journal {
   void set_plant(std::string plant) { plant_ = std::move(plant); }
   // Appends one verdict and forces it to disk.
   bool append(const Execution& e, const Progress& p, std::string* err);
+  // Appends a verdict line rendered elsewhere (parallel runs), and forces it to disk.
+  bool append_line(const std::string& line, std::string* err);
 
  private:
   bool write_line(const std::string& line, std::string* err);
@@ -49,5 +52,11 @@ class Journal {
 
 // One verdict as a journal line (without the newline); exposed for tests.
 std::string journal_line(const Execution& e, const TestCase& tc, const Progress& p);
+// The header line; `plant` empty: none named.
+std::string journal_header(const std::string& campaign, const std::string& plant, const std::string& fingerprint,
+                           size_t cases);
+// An execution from a journal line's object (case looked up in `cases`); false and *why
+// when a field the journal needs is missing or malformed.
+bool parse_execution(const common::Json& o, const std::vector<TestCase>& cases, Execution* out, std::string* why);
 
 }  // namespace plcfi::campaign

@@ -14,6 +14,7 @@
 
 #include "campaign/driver.hpp"
 #include "campaign/generate.hpp"
+#include "campaign/parallel.hpp"
 #include "commands.hpp"
 #include "options.hpp"
 #include "json.hpp"
@@ -214,7 +215,7 @@ int cmd_generate(const std::vector<std::string>& args) {
 
 int cmd_campaign(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--no-vcd] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]]";
+      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--no-vcd] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N]";
   po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
   desc.add_options()
       ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
@@ -230,9 +231,34 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("realtime", "pace the scans in real time (always on with real I/O); report wake latency, execution time, overruns")
       ("rt-priority", po::value<RtPriority>()->default_value(RtPriority{0}, "0"), "with real time: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
       ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with real time: pin the scan thread to this CPU")
-      ("native", "run program, preconditions and monitors through the native tier");
+      ("native", "run program, preconditions and monitors through the native tier")
+      ("jobs", po::value<IntIn<1, 256>>(), "run the tests on N worker processes; the journal is the one --jobs 1 writes")
+      ("shard", po::value<std::string>(), "run share K of N (K = 0..N-1) into OUT/shard-K-of-N.jsonl; `plcfi merge` "
+                                          "combines the N shard files into the campaign's journal");
   po::variables_map vm;
   if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
+  const int jobs = vm.count("jobs") ? static_cast<int>(vm["jobs"].as<IntIn<1, 256>>().value) : 1;
+  int shard_k = 0, shard_n = 0;
+  if (vm.count("shard")) {
+    std::string why;
+    if (!campaign::parse_share(vm["shard"].as<std::string>(), &shard_k, &shard_n, &why)) {
+      std::cerr << "plcfi campaign: --shard " << why << "\n";
+      return 2;
+    }
+    for (const char* o : {"jobs", "resume", "junit", "io", "realtime"})
+      if (vm.count(o)) {
+        std::cerr << "plcfi campaign: --shard runs one share of an offline campaign; --" << o
+                  << " does not go with it (run `plcfi merge` on the shard files, then look at the journal)\n";
+        return 2;
+      }
+  }
+  if (jobs > 1)
+    for (const char* o : {"io", "realtime"})
+      if (vm.count(o)) {
+        std::cerr << "plcfi campaign: --jobs splits an offline campaign between processes; --" << o
+                  << " runs on one machine's real time: drop --jobs\n";
+        return 2;
+      }
   CampaignBuild cb;
   std::vector<std::string> programs;
   if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
@@ -241,6 +267,17 @@ int cmd_campaign(const std::vector<std::string>& args) {
                         vm.count("plant") ? vm["plant"].as<std::string>() : ""))
     return 2;
   const auto& c = cb.spec;
+  if ((jobs > 1 || shard_n > 0) && !c.io.empty()) {
+    std::cerr << "plcfi campaign: " << c.path << ": the campaign runs on real I/O (io: " << c.io
+              << "); --jobs and --shard split offline campaigns only\n";
+    return 2;
+  }
+  if ((jobs > 1 || shard_n > 0) && c.restart == campaign::RestartKind::Warm) {
+    std::cerr << "plcfi campaign: " << c.path
+              << ": restart: warm carries each run's retained state into the next run, so the runs cannot be split "
+                 "between processes; use restart: cold for --jobs or --shard\n";
+    return 2;
+  }
   std::string out = vm.count("out") ? vm["out"].as<std::string>()
                                     : (std::filesystem::path("plcfi-out") /
                                        (c.name + "-" + std::filesystem::path(c.programs.back()).stem().string()))
@@ -275,6 +312,26 @@ int cmd_campaign(const std::vector<std::string>& args) {
               << std::flush;
     progress_line(p);
   };
+  if (shard_n > 0) {
+    opt.on_progress = nullptr;
+    opt.on_verdict = [&](const campaign::Execution& e, const campaign::Progress&) {
+      std::cout << fmt::format("  [run {:>2}, t={:7.3f} s] {} path {} {}: {}\n", e.run, static_cast<double>(e.inject_ns) * 1e-9,
+                               e.case_id, e.path, campaign::outcome_name(e.outcome), cb.cases[e.case_index].transition_ref())
+                << std::flush;
+    };
+    const std::string shard_path =
+        (std::filesystem::path(out) / fmt::format("shard-{}-of-{}.jsonl", shard_k, shard_n)).string();
+    campaign::ShardSummary sum;
+    if (!campaign::run_campaign_shard(cb, shard_k, shard_n, opt, shard_path, &sum, &err)) {
+      std::cerr << "plcfi campaign: " << err << "\n";
+      return 2;
+    }
+    std::cout << fmt::format("\nshard {}/{}: {} run(s) searched, {} tested here: {} PASS, {} FAIL; stopped: {}\n", shard_k,
+                             shard_n, sum.runs, sum.executions, sum.pass, sum.fail, sum.end_reason);
+    std::cout << fmt::format("shard file {}; combine the {} shard files with: plcfi merge --out DIR FILES...\n", shard_path,
+                             shard_n);
+    return 0;
+  }
   campaign::CampaignResult res;
   std::string io_path = vm.count("io") ? vm["io"].as<std::string>() : c.io;
   bool ran = false;
@@ -320,7 +377,13 @@ int cmd_campaign(const std::vector<std::string>& args) {
       opt.signals = &*signals;
       warn_realtime_setup(rto, "plcfi campaign");
     }
-    ran = campaign::run_campaign(cb, opt, &res, &err);
+    if (jobs > 1) {
+      if (live) std::cerr << fmt::format("  {} worker processes\n", jobs);
+      opt.on_progress = nullptr;
+      ran = campaign::run_campaign_jobs(cb, jobs, opt, &res, &err);
+    } else {
+      ran = campaign::run_campaign(cb, opt, &res, &err);
+    }
   }
   if (!ran) {
     if (live) std::cerr << "\n";

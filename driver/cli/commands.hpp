@@ -27,6 +27,7 @@ int cmd_plant_server(const std::vector<std::string>& args);
 int cmd_script(const std::vector<std::string>& args);
 int cmd_history(const std::vector<std::string>& args);
 int cmd_plant(const std::vector<std::string>& args);
+int cmd_merge(const std::vector<std::string>& args);
 
 // --native: the application's native tier, built (or found in the cache) and reported
 // on stderr as `who: native tier: ...`; nullptr after printing the error.

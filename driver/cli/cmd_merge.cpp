@@ -1,0 +1,59 @@
+// plcfi merge: the shard files of a campaign (campaign --shard K/N) into the journal the
+// campaign writes when one process runs it.
+#include <filesystem>
+#include <iostream>
+
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+#include "campaign/parallel.hpp"
+#include "commands.hpp"
+#include "options.hpp"
+
+namespace po = boost::program_options;
+
+namespace plcfi::cli {
+
+int cmd_merge(const std::vector<std::string>& args) {
+  const std::string usage = "plcfi merge --out DIR SHARD_FILE...";
+  po::options_description desc(
+      "plcfi merge: combine the N shard files of a campaign (plcfi campaign --shard K/N) into DIR/results.jsonl, the "
+      "journal one process running the whole campaign writes");
+  desc.add_options()("out", po::value<std::string>(), "output folder for results.jsonl (required)");
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm, usage)) return 0;
+  if (!vm.count("out") || !vm.count("files")) {
+    std::cerr << "plcfi merge: expected --out DIR and the shard files\nusage: " << usage << "\n";
+    return 2;
+  }
+  const auto files = vm["files"].as<std::vector<std::string>>();
+  const std::string out = vm["out"].as<std::string>();
+  const std::string journal = (std::filesystem::path(out) / "results.jsonl").string();
+  campaign::MergeResult m;
+  std::string err;
+  if (!campaign::merge_shards(files, journal, &m, &err)) {
+    std::cerr << "plcfi merge: " << err << "\n";
+    return 2;
+  }
+  size_t pass = 0, fail = 0;
+  std::cout << fmt::format("plcfi merge: campaign {}, {} shard file(s)\n\n", m.campaign, files.size());
+  for (const auto& e : m.executions) {
+    (e.verdict == "PASS" ? pass : fail)++;
+    std::cout << fmt::format("  [run {:>2}] {} path {} {}: {}\n", e.run, e.case_id, e.path, e.verdict, e.transition);
+    if (e.verdict != "PASS") std::cout << "           " << e.reason << "\n";
+  }
+  for (const auto& id : m.not_reached) std::cout << fmt::format("  {} NOT REACHED\n", id);
+  const auto& p = m.progress;
+  std::cout << fmt::format("\n{} execution(s) of {} case(s): {} PASS, {} FAIL, {} NOT REACHED\n", m.executions.size(), m.cases,
+                           pass, fail, m.not_reached.size());
+  std::cout << fmt::format("{} run(s), {} scans, {:.1f} s on the scan clock; ended: {}\n", p.run, p.scans,
+                           static_cast<double>(p.campaign_ns) * 1e-9, m.end_reason);
+  std::cout << fmt::format("journal {}, {} trace(s) copied from the shard folders\n", journal, m.traces_copied);
+  if (!m.traces_missing.empty()) {
+    std::cout << fmt::format("{} trace(s) not found beside their shard file:\n", m.traces_missing.size());
+    for (const auto& t : m.traces_missing) std::cout << "  " << t << "\n";
+  }
+  return fail || !m.not_reached.empty() ? 1 : 0;
+}
+
+}  // namespace plcfi::cli
