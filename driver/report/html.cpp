@@ -586,7 +586,12 @@ void executions_section(const HtmlReport& r, std::string& o) {
          "<span><i style=\"background:#2b8a3e\"></i>reaction</span><span><i style=\"background:#ffd8b0\"></i>faulted signal</span>"
          "<span><i style=\"background:#f8c4c4\"></i>alarm</span></p>\n";
   }
-  for (size_t i = 0; i < r.executions.size(); ++i) {
+  // The executions that did not pass first: they are what the reader came for.
+  std::vector<size_t> order;
+  for (int pass = 0; pass < 2; ++pass)
+    for (size_t i = 0; i < r.executions.size(); ++i)
+      if ((r.executions[i].verdict == HtmlVerdict::Pass) == (pass == 1)) order.push_back(i);
+  for (size_t i : order) {
     const auto& e = r.executions[i];
     o += fmt::format("<section class=\"exec {}\" id=\"x{}\">\n<h3>{} {}</h3>\n", verdict_class(e.verdict), i, badge(e.verdict), esc(e.title));
     if (!e.summary.empty()) o += fmt::format("<p>{}</p>\n", esc(e.summary));

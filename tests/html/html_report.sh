@@ -23,6 +23,11 @@ status=$?
 grep -qx "HTML report: $out/report/index.html" "$out/campaign.txt" || fail "the report's path was not printed"
 page=$out/report/index.html
 [[ -s $page ]] || fail "$page missing"
+# Deterministic: the same campaign again gives the same page, byte for byte.
+cp "$page" "$out/first.html"
+rm -rf "$out/campaign" "$out/report"
+"$plcfi" campaign "$campaign" --out "$out/campaign" --html "$out/report" --quiet >/dev/null 2>&1
+cmp "$out/first.html" "$page" || fail "a second run of the campaign wrote another page"
 # Self-contained: nothing loaded from elsewhere, no scripts.
 if grep -Eq '<script|<link|<img|<iframe|src=|url\(|@import' "$page"; then fail "$page refers to external resources or scripts"; fi
 

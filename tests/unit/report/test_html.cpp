@@ -207,6 +207,17 @@ TEST(HtmlReport, SameModelSameBytesAndUnwritableFolder) {
   EXPECT_EQ(ta, html_report(r));
   EXPECT_NE(ta.find("<a href=\"#x0\">TC1</a>"), std::string::npos);
   EXPECT_NE(ta.find("<section class=\"exec fail\" id=\"x0\">"), std::string::npos);
+  // A passing execution added before it in the model is drawn after the failure.
+  HtmlExecution ok = e;
+  ok.title = "TC0 path 1";
+  ok.verdict = HtmlVerdict::Pass;
+  r.executions.insert(r.executions.begin(), ok);
+  r.rows[0].execution = 1;
+  std::string two = html_report(r);
+  size_t fail_at = two.find("<section class=\"exec fail\" id=\"x1\">"), pass_at = two.find("<section class=\"exec pass\" id=\"x0\">");
+  ASSERT_NE(fail_at, std::string::npos);
+  ASSERT_NE(pass_at, std::string::npos);
+  EXPECT_LT(fail_at, pass_at);
   // Self-contained: nothing is loaded from elsewhere.
   for (const char* ext : {"src=", "<link", "@import", "url("}) EXPECT_EQ(ta.find(ext), std::string::npos) << ext;
   std::filesystem::remove_all(a);
