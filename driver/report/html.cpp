@@ -195,6 +195,7 @@ bool waveform_svg(const HtmlExecution& e, std::string* svg, std::string* err) {
   err->clear();
   if (!read_lanes(e, &lanes, &first, &last, err)) return false;
   int64_t t0 = std::min(first, e.inject_ns);
+  if (e.start_ns >= 0) t0 = std::min(t0, e.start_ns);  // every marker inside the plot
   int64_t t1 = std::max({last, e.end_ns, e.deadline_ns, e.reaction_ns, e.start_ns});
   if (t1 <= t0) t1 = t0 + 1'000'000;
   // The signals are known up to the end of the recording (the test's end): a deadline after
