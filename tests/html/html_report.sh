@@ -20,6 +20,8 @@ mkdir -p "$out"
 "$plcfi" campaign "$campaign" --out "$out/campaign" --html "$out/report" --quiet >"$out/campaign.txt" 2>&1
 status=$?
 [[ $status -eq 1 ]] || { cat "$out/campaign.txt"; fail "plcfi campaign exited $status, expected 1"; }
+# (A sanitizer report also exits 1: look for one.)
+if grep -qE "Sanitizer|runtime error:|terminate called" "$out/campaign.txt"; then cat "$out/campaign.txt"; fail "plcfi crashed or a sanitizer reported"; fi
 grep -qx "HTML report: $out/report/index.html" "$out/campaign.txt" || fail "the report's path was not printed"
 page=$out/report/index.html
 [[ -s $page ]] || fail "$page missing"
