@@ -18,6 +18,7 @@
 #include "commands.hpp"
 #include "options.hpp"
 #include "json.hpp"
+#include "html_campaign.hpp"
 #include "report/junit.hpp"
 #include "report/puml.hpp"
 
@@ -215,7 +216,7 @@ int cmd_generate(const std::vector<std::string>& args) {
 
 int cmd_campaign(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--no-vcd] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N]";
+      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--no-vcd] [--html DIR] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N]";
   po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
   desc.add_options()
       ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
@@ -225,6 +226,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("plant", po::value<std::string>(), "plant instead of the campaign's: a built-in plant's name or a plant file (FMU, ST)")
       ("seed", po::value<Count>(), "seed instead of the campaign's")
       ("no-vcd", "no VCD trace per test")
+      ("html", po::value<std::string>(), "write a self-contained HTML report (DIR/index.html): verdicts, waveforms, TSD")
       ("quiet", "no live progress line")
       ("io", po::value<std::string>(), "run on real I/O: a file with an io: section (instead of the campaign's io: or plant)")
       ("arm", "allow fault injection on real I/O (required with io:)")
@@ -245,7 +247,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
       std::cerr << "plcfi campaign: --shard " << why << "\n";
       return 2;
     }
-    for (const char* o : {"jobs", "resume", "junit", "io", "realtime"})
+    for (const char* o : {"jobs", "resume", "junit", "html", "io", "realtime"})
       if (vm.count(o)) {
         std::cerr << "plcfi campaign: --shard runs one share of an offline campaign; --" << o
                   << " does not go with it (run `plcfi merge` on the shard files, then look at the journal)\n";
@@ -283,6 +285,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
                                        (c.name + "-" + std::filesystem::path(c.programs.back()).stem().string()))
                                           .string();
   std::string err;
+  if (vm.count("html") && !html_dir_writable(vm["html"].as<std::string>(), &err)) {  // before a long campaign, not after it
+    std::cerr << "plcfi campaign: " << err << "\n";
+    return 2;
+  }
   if (!write_diagrams(cb, (std::filesystem::path(out) / "diagrams").string(), &err)) {
     std::cerr << "plcfi campaign: " << err << "\n";
     return 2;
@@ -492,6 +498,14 @@ int cmd_campaign(const std::vector<std::string>& args) {
       std::cerr << "plcfi campaign: " << err << "\n";
       return 2;
     }
+  }
+  if (vm.count("html")) {
+    std::string dir = vm["html"].as<std::string>();
+    if (!report::write_html_report(html_campaign_model(cb, res, out, opt.vcd), dir, &err)) {
+      std::cerr << "plcfi campaign: " << err << "\n";
+      return 2;
+    }
+    std::cout << "HTML report: " << (std::filesystem::path(dir) / "index.html").string() << "\n";
   }
   if (res.interrupted) {
     std::cout << "campaign incomplete (" << res.end_reason << "); finish it with --resume\n";
