@@ -33,6 +33,12 @@ struct DriverOptions {
   std::function<std::string()> io_lost;
   std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
   const st::NativeCode* native = nullptr;  // run program, preconditions and monitors natively
+  // Mutation analysis (mutate.hpp). stop_after: called after each verdict; true ends the
+  // campaign there (end_reason "stopped after ..."). window_branches: when set, the branch
+  // ids the program took in the scans of every test window are OR-ed into it
+  // (Machine::taken() layout).
+  std::function<bool(const Execution&)> stop_after;
+  std::vector<uint64_t>* window_branches = nullptr;
 };
 
 struct CampaignResult {
