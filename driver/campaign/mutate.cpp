@@ -228,6 +228,16 @@ bool run_parallel(CampaignBuild& cb, const Baseline& base, const std::vector<Mut
                   unsigned jobs, std::vector<MutantResult>* results, std::string* err) {
   std::vector<Worker> ws(std::min<size_t>(jobs, todo.size()));
   bool ok = true;
+  // A worker that died must show as an error here (EPIPE), not end this process.
+  struct IgnorePipe {
+    struct sigaction old {};
+    IgnorePipe() {
+      struct sigaction sa {};
+      sa.sa_handler = SIG_IGN;
+      ::sigaction(SIGPIPE, &sa, &old);
+    }
+    ~IgnorePipe() { ::sigaction(SIGPIPE, &old, nullptr); }
+  } ignore_pipe;
   for (auto& w : ws) {
     int a[2], b[2];
     if (::pipe(a) != 0 || ::pipe(b) != 0) {
