@@ -65,6 +65,9 @@ struct Mutant {
 // operator). Equivalence proofs are filled in: byte-identical patch, duplicate of an
 // earlier mutant, or code unreachable from every task entry.
 std::vector<Mutant> generate_mutants(const CampaignBuild& cb);
+// The proofs from the patches alone (part of generate_mutants): a patch that leaves code
+// and image byte-identical, and a patch equal to an earlier mutant's (reported there).
+void mark_patch_equivalents(const st::Application& app, std::vector<Mutant>* mutants);
 
 // Applies / undoes a mutant's patches on cb's application (in place; the sizes never change).
 void apply_mutant(CampaignBuild& cb, const Mutant& m, std::vector<CodePatch>* undo_code, std::vector<ImagePatch>* undo_image);

@@ -675,43 +675,14 @@ class Generator {
     out_.push_back(std::move(m));
   }
 
-  // Equivalence proofs: the same code and image as the original; the same patch as an
-  // earlier mutant; code no task reaches.
+  // Equivalence proofs: the patch proofs (mark_patch_equivalents), then code no task reaches.
   void prove() {
-    std::map<std::string, size_t> seen;
-    for (Mutant& m : out_) {
-      bool identical = true;
-      std::string key;
-      for (const auto& c : m.code) {
-        key += fmt::format("c{}:", c.pc);
-        for (size_t k = 0; k < c.words.size(); ++k) {
-          key += fmt::format("{},", c.words[k]);
-          identical = identical && app_.code[c.pc + k] == c.words[k];
-        }
-      }
-      for (const auto& im : m.image) {
-        key += fmt::format("i{}:", im.addr);
-        for (size_t k = 0; k < im.bytes.size(); ++k) {
-          key += fmt::format("{},", im.bytes[k]);
-          identical = identical && app_.init_image[im.addr + k] == im.bytes[k];
-        }
-      }
-      if (identical) {
-        m.equivalent = true;
-        m.proof = "the patched program is byte-identical to the original";
-        continue;
-      }
-      auto [it, fresh] = seen.emplace(key, m.index);
-      if (!fresh) {
-        m.equivalent = true;
-        m.proof = fmt::format("the same patch as mutant #{} (reported there)", it->second);
-        continue;
-      }
-      if (m.image.empty() && !reached_.count(m.pou)) {
+    mark_patch_equivalents(app_, &out_);
+    for (Mutant& m : out_)
+      if (!m.equivalent && m.image.empty() && !reached_.count(m.pou)) {
         m.equivalent = true;
         m.proof = fmt::format("{} is never called from a task's program: its code is unreachable", m.pou->name);
       }
-    }
   }
 
   struct Store {
@@ -746,5 +717,37 @@ class Generator {
 }  // namespace
 
 std::vector<Mutant> generate_mutants(const CampaignBuild& cb) { return Generator(cb).run(); }
+
+void mark_patch_equivalents(const st::Application& app, std::vector<Mutant>* mutants) {
+  std::map<std::string, size_t> seen;
+  for (Mutant& m : *mutants) {
+    bool identical = true;
+    std::string key;
+    for (const auto& c : m.code) {
+      key += fmt::format("c{}:", c.pc);
+      for (size_t k = 0; k < c.words.size(); ++k) {
+        key += fmt::format("{},", c.words[k]);
+        identical = identical && app.code[c.pc + k] == c.words[k];
+      }
+    }
+    for (const auto& im : m.image) {
+      key += fmt::format("i{}:", im.addr);
+      for (size_t k = 0; k < im.bytes.size(); ++k) {
+        key += fmt::format("{},", im.bytes[k]);
+        identical = identical && app.init_image[im.addr + k] == im.bytes[k];
+      }
+    }
+    if (identical) {
+      m.equivalent = true;
+      m.proof = "the patched program is byte-identical to the original";
+      continue;
+    }
+    auto [it, fresh] = seen.emplace(key, m.index);
+    if (!fresh) {
+      m.equivalent = true;
+      m.proof = fmt::format("the same patch as mutant #{} (reported there)", it->second);
+    }
+  }
+}
 
 }  // namespace plcfi::campaign

@@ -177,6 +177,29 @@ TEST(Mutate, DeadCodeIsProvenEquivalent) {
   for (size_t i = 0; i < again.size(); ++i) EXPECT_EQ(again[i].change, s.mutants[i].change);
 }
 
+TEST(Mutate, PatchProofs) {
+  Small s;
+  const st::Application& app = *s.cb.build->app;
+  const Mutant* remove = s.find(MutationOp::RemoveAssign, 23);
+  ASSERT_NE(remove, nullptr);
+  std::vector<Mutant> ms(3, *remove);
+  for (size_t i = 0; i < ms.size(); ++i) ms[i].index = i;
+  // #0 rewrites the instruction with its own words; #2 repeats #1's patch.
+  ms[0].code[0].words.assign(app.code.begin() + ms[0].pc, app.code.begin() + ms[0].pc + ms[0].code[0].words.size());
+  mark_patch_equivalents(app, &ms);
+  EXPECT_TRUE(ms[0].equivalent);
+  EXPECT_EQ(ms[0].proof, "the patched program is byte-identical to the original");
+  EXPECT_FALSE(ms[1].equivalent);
+  EXPECT_TRUE(ms[2].equivalent);
+  EXPECT_EQ(ms[2].proof, "the same patch as mutant #1 (reported there)");
+  // The generated list has no duplicate patch.
+  for (const auto& m : s.mutants) {
+    if (m.equivalent) {
+      EXPECT_EQ(m.proof.find("the same patch"), std::string::npos) << m.change;
+    }
+  }
+}
+
 std::string read(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
