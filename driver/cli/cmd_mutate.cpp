@@ -1,5 +1,6 @@
 // plcfi mutate: mutation analysis of a program's error handling against a campaign.
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include <boost/program_options.hpp>
@@ -79,7 +80,15 @@ int cmd_mutate(const std::vector<std::string>& args) {
       return 2;
     }
   }
-  if (vm.count("out")) opt.out_dir = vm["out"].as<std::string>();
+  if (vm.count("out")) {
+    opt.out_dir = vm["out"].as<std::string>();
+    std::error_code ec;
+    std::filesystem::create_directories(opt.out_dir, ec);  // before any work: a bad folder is bad usage
+    if (ec) {
+      std::cerr << "plcfi mutate: " << opt.out_dir << ": cannot create the output folder: " << ec.message() << "\n";
+      return 2;
+    }
+  }
 
   campaign::Campaign spec;
   const std::string path = vm["campaign-file"].as<std::vector<std::string>>()[0];
