@@ -148,6 +148,12 @@ class PassiveDriver final : public rt::ScanHooks {
 
   void after_scan(rt::Runtime& r) override {
     if (active_ == SIZE_MAX) return;
+    if (opt_.window_branches) {  // before the monitors run on the same machine
+      const auto& taken = r.machine().taken();
+      auto& w = *opt_.window_branches;
+      if (w.size() < taken.size()) w.resize(taken.size(), 0);
+      for (size_t k = 0; k < taken.size(); ++k) w[k] |= taken[k];
+    }
     const TestCase& tc = cb_.cases[active_];
     int64_t t = r.now();
     monitors_->step(r.machine(), state_++, t);
@@ -464,6 +470,10 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
       if (journal.is_open() && !journal.append(e, pr, err)) return false;
       out->executions.push_back(e);
       if (opt.on_verdict) opt.on_verdict(e, pr);
+      if (opt.stop_after && opt.stop_after(out->executions.back())) {
+        out->end_reason = "stopped after " + e.case_id + " path " + std::to_string(e.path);
+        break;
+      }
       if (shared) {
         rec.kind = RunRecord::Kind::Executed;
         rec.line = journal_line(e, cb.cases[e.case_index], Progress{});

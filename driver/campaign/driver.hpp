@@ -40,6 +40,12 @@ struct DriverOptions {
   int share_k = 0, share_n = 1;
   std::function<bool(const RunRecord&)> on_run;
   const JournalState* resumed = nullptr;  // with on_run: start from this journal state
+  // Mutation analysis (mutate.hpp). stop_after: called after each verdict; true ends the
+  // campaign there (end_reason "stopped after ..."). window_branches: when set, the branch
+  // ids the program took in the scans of every test window are OR-ed into it
+  // (Machine::taken() layout).
+  std::function<bool(const Execution&)> stop_after;
+  std::vector<uint64_t>* window_branches = nullptr;
 };
 
 struct CampaignResult {

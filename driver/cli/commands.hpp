@@ -23,6 +23,7 @@ int cmd_sim(const std::vector<std::string>& args);
 int cmd_edtl(const std::vector<std::string>& args);
 int cmd_generate(const std::vector<std::string>& args);
 int cmd_campaign(const std::vector<std::string>& args);
+int cmd_mutate(const std::vector<std::string>& args);
 int cmd_plant_server(const std::vector<std::string>& args);
 int cmd_script(const std::vector<std::string>& args);
 int cmd_history(const std::vector<std::string>& args);

@@ -32,6 +32,7 @@ const std::vector<Command>& commands() {
       {"edtl", "check EDTL requirements on a recorded trace (edtl check REQS TRACE)", plcfi::cli::cmd_edtl},
       {"generate", "generate the prioritized fault-injection test cases of a campaign (TSD + FMEA)", plcfi::cli::cmd_generate},
       {"campaign", "run a passive fault-injection campaign on the plant model or, armed, on real I/O", plcfi::cli::cmd_campaign},
+      {"mutate", "mutation analysis of the program's error handling: mutants of the compiled program judged by a campaign", plcfi::cli::cmd_mutate},
       {"script", "run CPTest+ test scripts (.cpt) against a program and a plant model, with ASSERT_COM and link faults", plcfi::cli::cmd_script},
       {"history", "show the run history of test scripts, newest first", plcfi::cli::cmd_history},
       {"plant", "look at a plant's signals (plant info) or export the stamping plant as an FMU (plant export-fmu)", plcfi::cli::cmd_plant},

@@ -1,0 +1,141 @@
+// plcfi mutate: mutation analysis of a program's error handling against a campaign.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <boost/program_options.hpp>
+#include <fmt/format.h>
+
+#include "campaign/generate.hpp"
+#include "campaign/mutate.hpp"
+#include "commands.hpp"
+#include "common/json.hpp"
+#include "options.hpp"
+
+namespace po = boost::program_options;
+
+namespace plcfi::cli {
+
+namespace {
+
+// "K/N" with 0 <= K < N (shards are counted from 0).
+bool parse_shard(const std::string& s, unsigned* k, unsigned* n, std::string* err) {
+  size_t slash = s.find('/');
+  bool neg = false;
+  uint64_t a = 0, b = 0;
+  if (slash == std::string::npos || !parse_whole(s.substr(0, slash), &neg, &a) || neg ||
+      !parse_whole(s.substr(slash + 1), &neg, &b) || neg) {
+    *err = "option '--shard': '" + s + "' is not K/N (e.g. 0/2: the first of two shards)";
+    return false;
+  }
+  if (b == 0 || b > 4096) {
+    *err = "option '--shard': '" + s + "': N must be from 1 to 4096";
+    return false;
+  }
+  if (a >= b) {
+    *err = fmt::format("option '--shard': '{}': K counts from 0, so it must be below N (0..{})", s, b - 1);
+    return false;
+  }
+  *k = static_cast<unsigned>(a);
+  *n = static_cast<unsigned>(b);
+  return true;
+}
+
+}  // namespace
+
+int cmd_mutate(const std::vector<std::string>& args) {
+  const std::string usage =
+      "plcfi mutate CAMPAIGN.yaml [--program FILE...] [--seed N] [--jobs N] [--shard K/N] [--out DIR] [--json] [--list] [--min-score P]";
+  po::options_description desc(
+      "plcfi mutate: mutation analysis of the program's error handling: mutants of the compiled program (stores to alarm/stop "
+      "variables removed, their guarding conditions negated, dropped or forced FALSE, timer presets scaled, latches cleared), "
+      "the campaign run on each (stop at the first kill), the score and every survivor");
+  desc.add_options()
+      ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
+      ("seed", po::value<Count>(), "seed instead of the campaign's")
+      ("jobs,j", po::value<IntIn<1, 256>>()->default_value(IntIn<1, 256>{1}, "1"), "worker processes judging mutants (same output as 1)")
+      ("shard", po::value<std::string>(), "judge only the mutants with index % N == K (K from 0 to N-1); combine the journals with merge")
+      ("out", po::value<std::string>(), "write DIR/mutants.jsonl (a header line, one line per mutant)")
+      ("json", "print the journal lines instead of the text report")
+      ("list", "list the mutants without running the campaign")
+      ("min-score", po::value<double>(), "exit 1 when the mutation score (percent) is below P");
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm, usage, "campaign-file")) return 0;
+  if (!vm.count("campaign-file") || vm["campaign-file"].as<std::vector<std::string>>().size() != 1) {
+    std::cerr << "plcfi mutate: expected one campaign file\nusage: " << usage << "\n";
+    return 2;
+  }
+  campaign::MutateOptions opt;
+  opt.jobs = static_cast<unsigned>(vm["jobs"].as<IntIn<1, 256>>().value);
+  std::string err;
+  if (vm.count("shard") && !parse_shard(vm["shard"].as<std::string>(), &opt.shard, &opt.shards, &err)) {
+    std::cerr << "plcfi mutate: " << err << "\n";
+    return 2;
+  }
+  double min_score = -1;
+  if (vm.count("min-score")) {
+    min_score = vm["min-score"].as<double>();
+    if (!(min_score >= 0 && min_score <= 100)) {
+      std::cerr << "plcfi mutate: option '--min-score': a percentage from 0 to 100\n";
+      return 2;
+    }
+  }
+  if (vm.count("out")) {
+    opt.out_dir = vm["out"].as<std::string>();
+    std::error_code ec;
+    std::filesystem::create_directories(opt.out_dir, ec);  // before any work: a bad folder is bad usage
+    if (ec) {
+      std::cerr << "plcfi mutate: " << opt.out_dir << ": cannot create the output folder: " << ec.message() << "\n";
+      return 2;
+    }
+  }
+
+  campaign::Campaign spec;
+  const std::string path = vm["campaign-file"].as<std::vector<std::string>>()[0];
+  if (!campaign::load_campaign(path, &spec, &err)) {
+    std::cerr << err << "\n";
+    return 2;
+  }
+  if (vm.count("program")) spec.programs = vm["program"].as<std::vector<std::string>>();
+  if (vm.count("seed")) spec.seed = vm["seed"].as<Count>().value;
+  // Campaign options that change what runs per mutant (e.g. exploration) are set on the
+  // spec here, before the one preparation: every mutant runs the same campaign.
+  campaign::CampaignBuild cb;
+  if (!campaign::prepare_campaign(std::move(spec), &cb, &err)) {
+    std::cerr << err << (err.empty() || err.back() == '\n' ? "" : "\n");
+    return 2;
+  }
+
+  if (vm.count("list")) {
+    auto mutants = campaign::generate_mutants(cb);
+    for (const auto& m : mutants)
+      std::cout << fmt::format("#{:<3} {}:{}:{} [{}] {}{}\n", m.index, m.file, m.line, m.col, campaign::mutation_op_name(m.op),
+                               m.change, m.equivalent ? "  (equivalent: " + m.proof + ")" : "");
+    std::cout << fmt::format("{} mutant(s)\n", mutants.size());
+    return 0;
+  }
+
+  std::fflush(stdout);  // nothing buffered may be written twice by the workers
+  campaign::MutationRun run;
+  if (!campaign::run_mutation(cb, opt, &run, &err)) {
+    std::cerr << "plcfi mutate: " << err << "\n";
+    return 2;
+  }
+  if (vm.count("json")) {
+    std::cout << campaign::mutation_header_line(cb, run, opt) << "\n";
+    for (size_t i = 0; i < run.mutants.size(); ++i)
+      if (run.evaluated[i]) std::cout << campaign::mutant_line(run.mutants[i], run.results[i]) << "\n";
+  } else {
+    if (opt.shards) std::cout << fmt::format("shard {}/{}: mutants with index % {} == {}\n", opt.shard, opt.shards, opt.shards, opt.shard);
+    std::cout << campaign::mutation_report(cb, run);
+    if (!opt.out_dir.empty()) std::cout << "journal " << opt.out_dir << "/mutants.jsonl\n";
+  }
+  double score = campaign::mutation_score(run);
+  if (min_score >= 0 && score >= 0 && score * 100.0 < min_score) {
+    std::cerr << fmt::format("plcfi mutate: mutation score {:.1f} % is below --min-score {}\n", score * 100.0, min_score);
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace plcfi::cli
