@@ -410,7 +410,7 @@ ExploreOracle::State ExploreOracle::step(st::Machine& m, int64_t now) {
       if (reached_[k] < 0 && mem[plan.tr + es.first_transition + k]) {
         reached_[k] = now;
         if (t.min_ns >= 0 && now - start_ns_ < t.min_ns) {
-          deviate(start_ns_ + t.max_ns, fmt::format("transition {}.{} after {}, before its min {} (at +{})", where, t.lifeline,
+          deviate(start_ns_ + t.max_ns, fmt::format("transition {}.{} too early: after {} of its min {} (at +{})", where, t.lifeline,
                                                     human_duration(now - start_ns_), human_duration(t.min_ns), rel(now)));
           return state_;
         }
