@@ -41,6 +41,11 @@ std::string campaign_fingerprint(const CampaignBuild& cb) {
     if (!common::read_file(p, common::kMaxSourceBytes, &text, &read_err)) text = read_err;
     mix(text);  // another program under test is another campaign
   }
+  if (cb.spec.explore.enabled && !cb.spec.requirements.empty()) {  // explored cases check them
+    std::string text, read_err;
+    if (!common::read_file(cb.spec.requirements, common::kMaxSpecBytes, &text, &read_err)) text = read_err;
+    mix(text);
+  }
   for (const auto& c : cb.cases) {
     mix(c.id);
     mix(c.precondition);
@@ -213,13 +218,23 @@ class PassiveDriver final : public rt::ScanHooks {
   // The verdict of an explored case: its class's forbidden reactions (monitors), then the
   // exploration oracle (detected or tolerated, explore.hpp).
   void explore_after_scan(rt::Runtime& r, const TestCase& tc, const std::vector<monitor::Verdict>& v, int64_t t) {
-    for (size_t k = 0; k < v.size(); ++k)
-      if (v[k].violated()) {
-        finish(r, Outcome::Fail, fmt::format("forbidden reaction at +{}: {}", rel(v[k].violations.front().time_ns),
-                                             cb_.monitors.requirements[tc.first_req + k].text));
+    // [0, forbidden): the class's forbidden reactions; then the campaign's requirements.
+    for (size_t k = 0; k < v.size(); ++k) {
+      if (!v[k].violated()) continue;
+      const auto& spec = cb_.monitors.requirements[tc.first_req + k];
+      if (k < tc.forbidden) {
+        finish(r, Outcome::Fail, fmt::format("forbidden reaction at +{}: {}", rel(v[k].violations.front().time_ns), spec.text));
         return;
       }
+      if (req_violation_.empty())
+        req_violation_ = fmt::format("requirement {} violated at +{} ({})", spec.id.substr(tc.id.size() + 1),
+                                     rel(v[k].violations.front().time_ns), spec.text);
+    }
     auto state = oracle_->step(r.machine(), t);
+    if (state == ExploreOracle::State::Tolerated && !req_violation_.empty()) {
+      finish(r, Outcome::Fail, "the TSD's transitions in time, but " + req_violation_);
+      return;
+    }
     if (state == ExploreOracle::State::Detected || state == ExploreOracle::State::Tolerated) {
       if (state == ExploreOracle::State::Detected) {
         exec_.reaction_ns = oracle_->verdict_ns();
@@ -282,7 +297,10 @@ class PassiveDriver final : public rt::ScanHooks {
       done_ = true;
       return;
     }
-    if (tc.explored) oracle_ = std::make_unique<ExploreOracle>(cb_, i, r.now());
+    if (tc.explored) {
+      oracle_ = std::make_unique<ExploreOracle>(cb_, i, r.now());
+      req_violation_.clear();
+    }
     active_ = i;
     injected_ = true;
     state_ = 0;
@@ -343,6 +361,7 @@ class PassiveDriver final : public rt::ScanHooks {
   uint64_t state_ = 0;
   std::unique_ptr<monitor::MonitorSet> monitors_;
   std::unique_ptr<ExploreOracle> oracle_;  // explored cases only
+  std::string req_violation_;              // the first campaign requirement an explored case violated
   std::unique_ptr<report::TraceWriter> trace_;
   std::vector<int64_t> start_time_, react_time_;
   Execution exec_;

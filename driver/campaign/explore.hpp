@@ -46,6 +46,14 @@
 //  - FAIL: the detection deadline passes without it ("effect seen": the deviation and "no
 //    alarm", or the alarms that were up), a forbidden reaction of the class, the program
 //    stopping, or the class's maximum test duration.
+// What the program sees is what the FMEA cases' monitors see too, and it is what makes a
+// weakened plausibility check visible: a sensor stuck at the value its own transition goes
+// to completes that transition at once, which the transition's min time or a later step
+// then shows (the plant's true values would call such a run tolerated).
+// Monitors, as for FMEA cases: the class's forbidden reactions (one that becomes true is a
+// FAIL at once) and the campaign's `requirements:` file (EDTL): a run the TSD calls
+// tolerated FAILS when one of them was violated; a detected run stays detected (the alarm
+// legitimately stops what the requirements describe).
 // A FAILed explored case is an FMEA suggestion: a row for the FMEA (fmea_suggestions.csv).
 #pragma once
 

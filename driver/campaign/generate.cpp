@@ -175,6 +175,19 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
     alarm_paths.insert(r.alarm);
   }
 
+  // The campaign's requirements (explored cases only), checked against the program alone
+  // so that a message points into their own file.
+  monitor::RequirementsFile campaign_reqs;
+  if (c.explore.enabled && !c.requirements.empty()) {
+    if (!monitor::load_requirements(c.requirements, &campaign_reqs, err)) return false;
+    auto mon = monitor::generate_monitors(campaign_reqs);
+    auto check = st::build_files(c.programs, opt, {mon.source(campaign_reqs.path)});
+    if (!check->ok()) {
+      *err = check->diags.render_all();
+      return false;
+    }
+  }
+
   // 2. One case per FMEA row, on the transition it names.
   std::vector<TestCase> cases;
   for (const auto& r : c.fmea.rows) {
@@ -294,6 +307,12 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
       out->monitors.requirements.push_back(r);
       ++tc.forbidden;
     }
+    if (tc.explored)
+      for (const auto& cr : campaign_reqs.requirements) {
+        monitor::RequirementSpec r = cr;
+        r.id = tc.id + "." + cr.id;
+        out->monitors.requirements.push_back(r);
+      }
     tc.reqs = out->monitors.requirements.size() - tc.first_req;
     if (tc.explored) {
       tc.expected = fmt::format("detected ({}) before the TSD deviates, or by the deviation's bound + {}; or tolerated "

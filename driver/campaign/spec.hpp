@@ -138,6 +138,9 @@ struct Campaign {
   RestartKind restart = RestartKind::Cold;
   std::string io;  // a file with an io: section: the campaign runs on real I/O (needs --arm)
   ExploreSettings explore;
+  // EDTL requirements (a requirements file) that an explored case must not violate to count
+  // as tolerated; "" = none. FMEA cases do not use them.
+  std::string requirements;
   Tsd tsd;
   Fmea fmea;
   FaultClasses classes;

@@ -351,3 +351,49 @@ TEST(CampaignExplore, ARatedSuggestionLoadsAsAnFmeaRowAndReplacesTheExploredCase
   EXPECT_FALSE(find(after, "normal.hold.StampUp", "stuck_at(1)"));  // now the FMEA's
   EXPECT_EQ(after.cases.size(), cb.cases.size());                  // one FMEA case more, one explored less
 }
+
+TEST(CampaignExplore, CampaignRequirementsTurnATolerableRunIntoAFail) {
+  Copy c("reqs");
+  c.append("campaign.yaml", "requirements: reqs.yaml\n");
+  std::ofstream(c.path("reqs.yaml")) << "requirements:\n"
+                                        "  - id: P1\n"
+                                        "    text: \"the pressure the program reads stays below 6300\"\n"
+                                        "    trigger: \"TRUE\"\n"
+                                        "    invariant: \"StampPressure < 6300\"\n"
+                                        "    final: \"FALSE\"\n";
+  CampaignBuild cb;
+  std::string err;
+  ASSERT_TRUE(prepare_explore(c.path("campaign.yaml"), &cb, &err)) << err;
+  const TestCase* offset = find(cb, "normal.stamp.StampPressure", "offset(500)");
+  const TestCase* setpoint = find(cb, "init.ref_lower.PressureSetpoint", "no_effect");
+  ASSERT_TRUE(offset && setpoint);
+  EXPECT_EQ(offset->reqs, offset->forbidden + 1);  // the class's forbidden reaction, then P1
+  for (size_t i = 0; i < 8; ++i) EXPECT_EQ(cb.cases[i].reqs, 2u) << cb.cases[i].id;  // FMEA cases: as before
+  CampaignResult r;
+  DriverOptions opt;
+  ASSERT_TRUE(run_campaign(cb, opt, &r, &err)) << err;
+  bool seen_offset = false, seen_setpoint = false;
+  for (const auto& e : r.executions) {
+    if (e.case_id == offset->id) {
+      seen_offset = true;
+      EXPECT_EQ(e.outcome, Outcome::Fail);
+      EXPECT_EQ(e.reason.rfind("the TSD's transitions in time, but requirement P1 violated at +", 0), 0u) << e.reason;
+    }
+    if (e.case_id == setpoint->id) {  // tolerated, and P1 holds
+      seen_setpoint = true;
+      EXPECT_EQ(e.outcome, Outcome::Pass) << e.reason;
+      EXPECT_EQ(e.reason.rfind("tolerated: ", 0), 0u) << e.reason;
+    }
+  }
+  EXPECT_TRUE(seen_offset && seen_setpoint);
+
+  // A bad formula is reported in the requirements file.
+  std::ofstream(c.path("reqs.yaml")) << "requirements:\n"
+                                        "  - id: P1\n"
+                                        "    text: \"bad\"\n"
+                                        "    trigger: \"TRUE\"\n"
+                                        "    invariant: \"NoSuchVariable < 6300\"\n";
+  CampaignBuild bad;
+  EXPECT_FALSE(prepare_explore(c.path("campaign.yaml"), &bad, &err));
+  EXPECT_NE(err.find("reqs.yaml:5:"), std::string::npos) << err;
+}
