@@ -101,6 +101,7 @@ class ExploreOracle {
  private:
   enum class Phase { AwaitPre, AwaitStart, Running };
   void deviate(int64_t bound_ns, std::string what);
+  State tolerated(int64_t now_ns);
   std::string rel(int64_t t) const;
 
   const CampaignBuild& cb_;
