@@ -1,7 +1,8 @@
 // Test-case generation: one test case per expected TSD transition that has an FMEA row
 // (precondition, fault, expected reaction, deadline, priority = RPN), compiled once with
 // the program under test: the preconditions of all cases into one generated PROGRAM, the
-// fault-class reactions into EDTL monitors.
+// fault-class reactions into EDTL monitors. With exploring on (explore.hpp), explored cases
+// X1... follow the FMEA's: one per TSD step, signal and fault model the FMEA lacks.
 #pragma once
 
 #include <cstdint>
