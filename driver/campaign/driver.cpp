@@ -15,6 +15,7 @@
 
 #include "common/file.hpp"
 #include "common/hash.hpp"
+#include "explore.hpp"
 #include "io/sim/plant_factory.hpp"
 #include "io/sim/sim_backend.hpp"
 #include "journal.hpp"
@@ -39,6 +40,11 @@ std::string campaign_fingerprint(const CampaignBuild& cb) {
     std::string text, read_err;
     if (!common::read_file(p, common::kMaxSourceBytes, &text, &read_err)) text = read_err;
     mix(text);  // another program under test is another campaign
+  }
+  if (cb.spec.explore.enabled && !cb.spec.requirements.empty()) {  // explored cases check them
+    std::string text, read_err;
+    if (!common::read_file(cb.spec.requirements, common::kMaxSpecBytes, &text, &read_err)) text = read_err;
+    mix(text);
   }
   for (const auto& c : cb.cases) {
     mix(c.id);
@@ -159,6 +165,10 @@ class PassiveDriver final : public rt::ScanHooks {
     monitors_->step(r.machine(), state_++, t);
     if (trace_) trace_->sample(t, r.machine());
     auto v = monitors_->verdicts();
+    if (tc.explored) {
+      explore_after_scan(r, tc, v, t);
+      return;
+    }
     size_t n_class = tc.reqs - tc.forbidden;
     bool all_met = true;
     for (size_t k = 0; k < v.size(); ++k) {
@@ -215,6 +225,42 @@ class PassiveDriver final : public rt::ScanHooks {
 
  private:
   std::string rel(int64_t t) const { return human_duration(t - exec_.inject_ns); }
+
+  // The verdict of an explored case: its class's forbidden reactions (monitors), then the
+  // exploration oracle (detected or tolerated, explore.hpp).
+  void explore_after_scan(rt::Runtime& r, const TestCase& tc, const std::vector<monitor::Verdict>& v, int64_t t) {
+    // [0, forbidden): the class's forbidden reactions; then the campaign's requirements.
+    for (size_t k = 0; k < v.size(); ++k) {
+      if (!v[k].violated()) continue;
+      const auto& spec = cb_.monitors.requirements[tc.first_req + k];
+      if (k < tc.forbidden) {
+        finish(r, Outcome::Fail, fmt::format("forbidden reaction at +{}: {}", rel(v[k].violations.front().time_ns), spec.text));
+        return;
+      }
+      if (req_violation_.empty())
+        req_violation_ = fmt::format("requirement {} violated at +{} ({})", spec.id.substr(tc.id.size() + 1),
+                                     rel(v[k].violations.front().time_ns), spec.text);
+    }
+    auto state = oracle_->step(r.machine(), t);
+    if (state == ExploreOracle::State::Tolerated && !req_violation_.empty()) {
+      finish(r, Outcome::Fail, "the TSD's transitions in time, but " + req_violation_);
+      return;
+    }
+    if (state == ExploreOracle::State::Detected || state == ExploreOracle::State::Tolerated) {
+      if (state == ExploreOracle::State::Detected) {
+        exec_.reaction_ns = oracle_->verdict_ns();
+        exec_.latency_ns = exec_.reaction_ns - exec_.inject_ns;
+      }
+      finish(r, Outcome::Pass, oracle_->reason());
+    } else if (state == ExploreOracle::State::Failed) {
+      finish(r, Outcome::Fail, oracle_->reason());
+    } else if (r.stopped()) {
+      finish(r, Outcome::Fail, "program stopped: " + r.stop_reason());
+    } else if (t - exec_.inject_ns >= tc.max_duration_ns) {
+      finish(r, Outcome::Fail, fmt::format("maximum test duration {} reached: neither detected nor the scenario done",
+                                           human_duration(tc.max_duration_ns)));
+    }
+  }
 
   // The control-flow path the coming scan takes, as a hash of the program's branch ids.
   void path_of_scan(rt::Runtime& r) {
@@ -279,6 +325,10 @@ class PassiveDriver final : public rt::ScanHooks {
       done_ = true;
       return;
     }
+    if (tc.explored) {
+      oracle_ = std::make_unique<ExploreOracle>(cb_, i, r.now());
+      req_violation_.clear();
+    }
     active_ = i;
     injected_ = true;
     state_ = 0;
@@ -320,6 +370,7 @@ class PassiveDriver final : public rt::ScanHooks {
       trace_.reset();
     }
     monitors_.reset();
+    oracle_.reset();
     active_ = SIZE_MAX;
     done_ = true;
   }
@@ -337,6 +388,8 @@ class PassiveDriver final : public rt::ScanHooks {
   bool done_ = false, injected_ = false, claimed_ = false;
   uint64_t state_ = 0;
   std::unique_ptr<monitor::MonitorSet> monitors_;
+  std::unique_ptr<ExploreOracle> oracle_;  // explored cases only
+  std::string req_violation_;              // the first campaign requirement an explored case violated
   std::unique_ptr<report::TraceWriter> trace_;
   std::vector<int64_t> start_time_, react_time_;
   Execution exec_;

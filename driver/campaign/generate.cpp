@@ -10,9 +10,13 @@
 
 #include <fmt/format.h>
 
+#include "explore.hpp"
+
 namespace plcfi::campaign {
 
-std::string TestCase::transition_ref() const { return scenario->id + "." + step->id + "." + transition->lifeline; }
+std::string TestCase::transition_ref() const {
+  return scenario->id + "." + step->id + "." + (explored ? target->name : transition->lifeline);
+}
 
 std::string st_duration(int64_t ns) {
   if (ns % 1'000'000 == 0) return fmt::format("T#{}ms", ns / 1'000'000);
@@ -57,8 +61,10 @@ bool parse_number(const std::string& s, double* v) {
   }
 }
 
-// ST text of "lifeline has value v" (analog: within tolerance).
-std::string state_expr(const Lifeline& l, const st::VarHandle& h, const std::string& value, double tol, std::string* human) {
+}  // namespace
+
+std::string lifeline_state(const Lifeline& l, const st::VarHandle& h, const std::string& value, double tol,
+                           std::string* human) {
   double v = 0;
   if (tol > 0 && !is_bool(h.type) && parse_number(value, &v) && h.type && (h.type->is_integer() || h.type->is_bitstring())) {
     auto [lo, hi] = type_range(h.type);
@@ -84,6 +90,8 @@ std::string state_expr(const Lifeline& l, const st::VarHandle& h, const std::str
   *human = l.name + " = " + value;
   return "(" + l.bind + " = " + value + ")";
 }
+
+namespace {
 
 std::string substitute(std::string text, const std::map<std::string, std::string>& vars) {
   for (const auto& [k, v] : vars) {
@@ -167,6 +175,19 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
     alarm_paths.insert(r.alarm);
   }
 
+  // The campaign's requirements (explored cases only), checked against the program alone
+  // so that a message points into their own file.
+  monitor::RequirementsFile campaign_reqs;
+  if (c.explore.enabled && !c.requirements.empty()) {
+    if (!monitor::load_requirements(c.requirements, &campaign_reqs, err)) return false;
+    auto mon = monitor::generate_monitors(campaign_reqs);
+    auto check = st::build_files(c.programs, opt, {mon.source(campaign_reqs.path)});
+    if (!check->ok()) {
+      *err = check->diags.render_all();
+      return false;
+    }
+  }
+
   // 2. One case per FMEA row, on the transition it names.
   std::vector<TestCase> cases;
   for (const auto& r : c.fmea.rows) {
@@ -188,7 +209,7 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
     for (const auto& ps : tc.step->pre) {
       const Lifeline* l = c.tsd.find(ps.lifeline);
       std::string h;
-      expr += (expr.empty() ? "" : " AND ") + state_expr(*l, binds[l->name], ps.value, l->tolerance, &h);
+      expr += (expr.empty() ? "" : " AND ") + lifeline_state(*l, binds[l->name], ps.value, l->tolerance, &h);
     }
     if (!tc.step->condition.empty()) expr += " AND (" + tc.step->condition + ")";
     tc.precondition = expr;
@@ -236,20 +257,25 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
     cases.push_back(std::move(tc));
   }
   std::stable_sort(cases.begin(), cases.end(), [](const TestCase& a, const TestCase& b) { return a.rpn > b.rpn; });
+  for (size_t i = 0; i < cases.size(); ++i) cases[i].id = fmt::format("TC{}", i + 1);
+  // Fault-space exploration: more cases after the FMEA's (explore.hpp).
+  if (c.explore.enabled && !add_explored_cases(out, papp, binds, &cases, err)) return false;
 
   // 3. Monitors: the class requirements with this case's values, then the forbidden
   // reactions (an invariant that must hold for the whole test).
   out->monitors.path = c.classes.path;
   for (size_t i = 0; i < cases.size(); ++i) {
     TestCase& tc = cases[i];
-    tc.id = fmt::format("TC{}", i + 1);
     std::map<std::string, std::string> vars = {{"alarm", tc.row->alarm},
                                                {"start", tc.start},
                                                {"deadline", st_duration(tc.deadline_ns)},
                                                {"signal", tc.target->bind}};
     tc.first_req = out->monitors.requirements.size();
     std::string reaction;
+    // An explored case's detection is the oracle's (explore.hpp): only its forbidden
+    // reactions are monitors.
     for (const auto& cr : tc.cls->requirements) {
+      if (tc.explored) break;
       monitor::RequirementSpec r;
       r.id = tc.id + "." + cr.id;
       r.text = substitute(cr.text, vars);
@@ -281,7 +307,19 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
       out->monitors.requirements.push_back(r);
       ++tc.forbidden;
     }
+    if (tc.explored)
+      for (const auto& cr : campaign_reqs.requirements) {
+        monitor::RequirementSpec r = cr;
+        r.id = tc.id + "." + cr.id;
+        out->monitors.requirements.push_back(r);
+      }
     tc.reqs = out->monitors.requirements.size() - tc.first_req;
+    if (tc.explored) {
+      tc.expected = fmt::format("detected ({}) before the TSD deviates, or by the deviation's bound + {}; or tolerated "
+                                "(the transitions of {}.{} and of the scenario's later steps in time)",
+                                tc.row->alarm, human_duration(tc.cls->reaction_time_ns), tc.scenario->id, tc.step->id);
+      continue;
+    }
     tc.expected = fmt::format("{} within {} of {}", reaction.empty() ? "(class requirements)" : reaction,
                               human_duration(tc.deadline_ns), tc.step->start.empty() ? "the precondition" : tc.start);
   }
@@ -294,6 +332,7 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   // their messages point at the formula's start.
   st::GeneratedSources late = {{"<preconditions>", out->preconditions_source, precondition_origins(out->cases, c.tsd.path)},
                                out->monitor_source.source(out->monitors.path, false)};
+  if (c.explore.enabled) late.emplace_back("<explore>", out->explore.source, out->explore.origins);
   if (!st::link_generated(*prog, late, opt)) {
     *err = prog->diags.render_all();
     return false;
@@ -314,6 +353,7 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   out->preconditions.path = std::string(kPreProgram) + ".pre";
   out->preconditions.type = pre->type;
   out->preconditions.addr = out->preconditions_addr + pre->offset;
+  if (c.explore.enabled && !bind_explore(out, err)) return false;
   std::string e;
 
   bool ok = app.has_configuration ? out->schedule.from_configuration(app, &e)

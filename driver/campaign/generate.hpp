@@ -1,10 +1,13 @@
 // Test-case generation: one test case per expected TSD transition that has an FMEA row
 // (precondition, fault, expected reaction, deadline, priority = RPN), compiled once with
 // the program under test: the preconditions of all cases into one generated PROGRAM, the
-// fault-class reactions into EDTL monitors.
+// fault-class reactions into EDTL monitors. With exploring on (explore.hpp), explored cases
+// X1... follow the FMEA's: one per TSD step, signal and fault model the FMEA lacks.
 #pragma once
 
 #include <cstdint>
+#include <deque>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,8 +22,11 @@
 namespace plcfi::campaign {
 
 struct TestCase {
-  std::string id;  // TC1, TC2, ... in priority order
+  std::string id;  // TC1, TC2, ... in priority order; X1, X2, ... explored cases after them
+  // The FMEA row; for an explored case a row made up by the exploration (empty id) that
+  // carries its failure mode, class and alarm (CampaignBuild::explored_rows).
   const FmeaRow* row = nullptr;
+  bool explored = false;
   const Scenario* scenario = nullptr;
   const Step* step = nullptr;
   const Transition* transition = nullptr;
@@ -37,7 +43,26 @@ struct TestCase {
   // the class requirements first, then one per forbidden reaction.
   size_t first_req = 0, reqs = 0, forbidden = 0;
   std::string expected;  // readable: "gStampCylError AND gStampStop within 600 ms of StampDown"
-  std::string transition_ref() const;  // scenario.step.lifeline
+  // Explored cases: the step's index in ExplorePlan::steps.
+  size_t explore_step = 0;
+  std::string transition_ref() const;  // scenario.step.lifeline (explored: scenario.step.faulted signal)
+};
+
+// The generated program and step table that the oracle of explored cases reads (explore.hpp).
+struct ExploreStep {
+  const Scenario* scenario = nullptr;
+  const Step* step = nullptr;
+  size_t first_transition = 0;  // index of its first transition in the program's tr[] array
+  int64_t window_ns = 0;        // the longest max time of its transitions
+  size_t last_of_scenario = 0;  // index of its scenario's last step
+};
+struct ExplorePlan {
+  std::vector<ExploreStep> steps;  // every TSD step, scenario by scenario, in file order
+  std::string source;              // PROGRAM __FI_EXPLORE
+  std::vector<st::LineOrigin> origins;  // its lines' places in the TSD and campaign file
+  uint32_t entry = 0, addr = 0;    // to call it
+  uint32_t pre = 0, start = 0, tr = 0, det = 0;  // absolute addresses of its BOOL arrays
+  std::vector<st::VarHandle> alarms;             // the FMEA's alarm variables
 };
 
 struct CampaignBuild {
@@ -52,6 +77,8 @@ struct CampaignBuild {
   uint32_t preconditions_entry = 0, preconditions_addr = 0;
   std::vector<uint32_t> program_files;  // source-manager ids of the program's own files
   std::vector<st::VarHandle> watch;     // lifelines and alarms, for traces
+  std::deque<FmeaRow> explored_rows;    // the made-up rows of explored cases (stable addresses)
+  ExplorePlan explore;                  // empty unless the campaign explores
 };
 
 // Generates and compiles the test cases. Errors (rendered diagnostics or FILE:LINE:COL
@@ -60,6 +87,11 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err);
 
 // The generated ST source of the preconditions (exposed for tests and `generate --json`).
 std::string precondition_program(const std::vector<TestCase>& cases);
+
+// ST text of "lifeline has value v" (analog: within tolerance `tol`); *human gets the
+// readable form.
+std::string lifeline_state(const Lifeline& l, const st::VarHandle& h, const std::string& value, double tol,
+                           std::string* human);
 
 // "T#600ms"-style text of a duration; "600 ms" for people.
 std::string st_duration(int64_t ns);

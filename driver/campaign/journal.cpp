@@ -34,6 +34,7 @@ std::string journal_line(const Execution& e, const TestCase& tc, const Progress&
   Json j;
   j["case"] = e.case_id;
   j["fmea"] = tc.row->id;
+  if (tc.explored) j["explore"] = true;  // a case the FMEA does not have (explore.hpp)
   j["transition"] = tc.transition_ref();
   j["path"] = e.path;
   j["path_hash"] = fmt::format("{:016x}", e.path_hash);

@@ -116,6 +116,15 @@ struct FaultClasses {
 
 enum class RestartKind { Cold, Warm };
 
+// The campaign file's `explore:` section: settings of the fault-space exploration beyond
+// the FMEA (explore.hpp). Exploring runs with `enabled: true` or `plcfi campaign --explore`.
+struct ExploreSettings {
+  bool enabled = false;
+  std::string default_class;  // class of a signal no FMEA row names; "" = none
+  Loc loc;                    // the `explore:` key, else the campaign file's first line
+  Loc class_loc;              // the default_class value
+};
+
 struct Campaign {
   std::string path, name, text;
   std::vector<std::string> programs;  // resolved against the campaign file's folder
@@ -128,6 +137,10 @@ struct Campaign {
   int64_t search_window_ns = 60'000'000'000;
   RestartKind restart = RestartKind::Cold;
   std::string io;  // a file with an io: section: the campaign runs on real I/O (needs --arm)
+  ExploreSettings explore;
+  // EDTL requirements (a requirements file) that an explored case must not violate to count
+  // as tolerated; "" = none. FMEA cases do not use them.
+  std::string requirements;
   Tsd tsd;
   Fmea fmea;
   FaultClasses classes;

@@ -18,7 +18,7 @@ std::string relative_to(const std::string& base_file, const std::string& p) {
 void parse_campaign(const common::YamlDoc& f, Campaign* c) {
   f.check_keys(f.root(),
          {"campaign", "text", "program", "dialect", "plant", "plant_config", "cycle", "tsd", "fmea", "fault_classes", "seed", "budget",
-          "max_paths", "search_window", "restart", "io"},
+          "max_paths", "search_window", "restart", "io", "explore", "requirements"},
          "a campaign file");
   c->path = f.path();
   c->name = f.scalar(f.required(f.root(), "campaign", "a campaign file"), "campaign");
@@ -44,6 +44,7 @@ void parse_campaign(const common::YamlDoc& f, Campaign* c) {
   if (f.root()["restart"])
     c->restart = f.word(f.root()["restart"], "restart", {"cold", "warm"}) == "warm" ? RestartKind::Warm : RestartKind::Cold;
   if (f.root()["io"]) c->io = relative_to(f.path(), f.scalar(f.root()["io"], "io"));
+  if (f.root()["requirements"]) c->requirements = relative_to(f.path(), f.scalar(f.root()["requirements"], "requirements"));
   std::string tsd = relative_to(f.path(), f.scalar(f.required(f.root(), "tsd", "a campaign file"), "tsd"));
   std::string fmea = relative_to(f.path(), f.scalar(f.required(f.root(), "fmea", "a campaign file"), "fmea"));
   std::string classes =
@@ -51,6 +52,20 @@ void parse_campaign(const common::YamlDoc& f, Campaign* c) {
   detail::parse_tsd(common::YamlDoc::open(tsd), &c->tsd);
   detail::parse_fmea(fmea, &c->fmea);
   detail::parse_classes(common::YamlDoc::open(classes), &c->classes);
+  c->explore.loc = Loc{f.path(), 1, 1};
+  if (YAML::Node ex = f.root()["explore"]) {
+    c->explore.loc = detail::loc_of(f, ex);
+    f.check_keys(ex, {"enabled", "default_class"}, "the explore section", true);
+    if (ex.IsMap()) {
+      if (ex["enabled"]) c->explore.enabled = f.boolean(ex["enabled"], "explore: enabled");
+      if (YAML::Node dc = ex["default_class"]) {
+        c->explore.default_class = f.scalar(dc, "explore: default_class");
+        c->explore.class_loc = detail::loc_of(f, dc);
+        if (!c->classes.find(c->explore.default_class))
+          f.fail(dc, "explore: default_class '" + c->explore.default_class + "' is not defined in " + c->classes.path);
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "campaign/driver.hpp"
+#include "campaign/explore.hpp"
 #include "campaign/generate.hpp"
 #include "campaign/parallel.hpp"
 #include "commands.hpp"
@@ -100,7 +101,7 @@ bool write_diagrams(const CampaignBuild& cb, const std::string& dir, std::string
 
 // Loads and generates; prints errors and returns false (exit 2) when the specs are bad.
 bool load_and_prepare(const std::string& path, const std::vector<std::string>& programs, const uint64_t* seed,
-                      CampaignBuild* cb, const std::string& plant = "") {
+                      CampaignBuild* cb, const std::string& plant = "", bool explore = false) {
   campaign::Campaign spec;
   std::string err;
   if (!campaign::load_campaign(path, &spec, &err)) {
@@ -109,6 +110,7 @@ bool load_and_prepare(const std::string& path, const std::vector<std::string>& p
   }
   if (!programs.empty()) spec.programs = programs;
   if (seed) spec.seed = *seed;
+  if (explore) spec.explore.enabled = true;
   if (!plant.empty()) {
     spec.plant = plant;  // as given on the command line: relative to the working folder
     spec.plant_config.clear();
@@ -128,7 +130,7 @@ void print_cases(const CampaignBuild& cb) {
   std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad("case", 5), pad("RPN", 4), pad("FMEA", 5), pad("class", 6),
                            pad("transition", 30), pad("fault", 40), "deadline");
   for (const auto& tc : cb.cases)
-    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad(std::to_string(tc.rpn), 4), pad(tc.row->id, 5),
+    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad(std::to_string(tc.rpn), 4), pad(tc.explored ? "-" : tc.row->id, 5),
                              pad(tc.cls->id, 6), pad(tc.transition_ref(), 30), pad(fault_text(tc), 40),
                              campaign::human_duration(tc.deadline_ns));
   std::cout << "\n";
@@ -156,6 +158,7 @@ std::string json_cases(const CampaignBuild& cb) {
     Json j;
     j["id"] = tc.id;
     j["fmea"] = tc.row->id;
+    if (tc.explored) j["explore"] = true;
     j["rpn"] = tc.rpn;
     j["fault_class"] = tc.cls->id;
     j["transition"] = tc.transition_ref();
@@ -174,6 +177,23 @@ std::string json_cases(const CampaignBuild& cb) {
   return o + "]\n";
 }
 
+// Explored cases that failed, as FMEA rows: listed and written to OUT/fmea_suggestions.csv.
+bool print_suggestions(const CampaignBuild& cb, const campaign::CampaignResult& res, const std::string& out) {
+  auto sug = campaign::fmea_suggestions(cb, res.executions);
+  std::string path = (std::filesystem::path(out) / "fmea_suggestions.csv").string();
+  std::ofstream f(path);
+  f << campaign::fmea_suggestions_csv(sug);
+  if (!f) {
+    std::cerr << "plcfi campaign: " << path << ": cannot write\n";
+    return false;
+  }
+  std::cout << fmt::format("\nFMEA suggestions: {} (the failures the FMEA misses, as rows in {})\n", sug.size(), path);
+  for (const auto& x : sug)
+    std::cout << fmt::format("  {} {}: {}; effect seen: {}; detecting alarm: {}\n", pad(x.case_id, 5), x.component,
+                             x.failure_mode, x.effect, x.detection);
+  return true;
+}
+
 // Parses the common arguments; returns 0 to go on, else the exit status (help, usage).
 int parse(const std::string& cmd, const std::string& usage, po::options_description& desc, const std::vector<std::string>& args,
           po::variables_map* vm) {
@@ -188,18 +208,20 @@ int parse(const std::string& cmd, const std::string& usage, po::options_descript
 }  // namespace
 
 int cmd_generate(const std::vector<std::string>& args) {
-  const std::string usage = "plcfi generate CAMPAIGN.yaml [--json] [--puml DIR] [--program FILE...]";
+  const std::string usage = "plcfi generate CAMPAIGN.yaml [--json] [--puml DIR] [--program FILE...] [--explore]";
   po::options_description desc("plcfi generate: the prioritized test set of a campaign (one case per TSD transition with an FMEA row)");
   desc.add_options()
       ("json", "print the test cases as JSON")
       ("puml", po::value<std::string>(), "write a PlantUML sequence and timing diagram per case into DIR")
-      ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's");
+      ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
+      ("explore", "add the explored cases: every signal of every TSD step under each applicable fault model");
   po::variables_map vm;
   if (int s = parse("generate", usage, desc, args, &vm)) return s < 0 ? 0 : s;
   CampaignBuild cb;
   std::vector<std::string> programs;
   if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
-  if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, nullptr, &cb)) return 2;
+  if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, nullptr, &cb, "", vm.count("explore") > 0))
+    return 2;
   if (vm.count("json")) std::cout << json_cases(cb);
   else print_cases(cb);
   if (vm.count("puml")) {
@@ -216,7 +238,7 @@ int cmd_generate(const std::vector<std::string>& args) {
 
 int cmd_campaign(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--no-vcd] [--html DIR] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N]";
+      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--explore] [--no-vcd] [--html DIR] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N]";
   po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
   desc.add_options()
       ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
@@ -225,6 +247,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
       ("plant", po::value<std::string>(), "plant instead of the campaign's: a built-in plant's name or a plant file (FMU, ST)")
       ("seed", po::value<Count>(), "seed instead of the campaign's")
+      ("explore", "also test the failures the FMEA forgot (explored cases X1...); failed ones become FMEA suggestions")
       ("no-vcd", "no VCD trace per test")
       ("html", po::value<std::string>(), "write a self-contained HTML report (DIR/index.html): verdicts, waveforms, TSD")
       ("quiet", "no live progress line")
@@ -266,7 +289,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
   if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
   uint64_t seed = vm.count("seed") ? vm["seed"].as<Count>().value : 0;
   if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, vm.count("seed") ? &seed : nullptr, &cb,
-                        vm.count("plant") ? vm["plant"].as<std::string>() : ""))
+                        vm.count("plant") ? vm["plant"].as<std::string>() : "", vm.count("explore") > 0))
     return 2;
   const auto& c = cb.spec;
   if ((jobs > 1 || shard_n > 0) && !c.io.empty()) {
@@ -414,7 +437,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
     std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(e.case_id, 5), pad(std::to_string(e.path), 5),
                              pad(campaign::outcome_name(e.outcome), 12), pad(lat, 9), pad(std::to_string(tc.rpn), 4),
                              pad(tc.transition_ref(), 30), fault_text(tc));
-    if (e.outcome != campaign::Outcome::Pass) std::cout << fmt::format("{}{}\n", std::string(38, ' '), e.reason);
+    if (e.outcome != campaign::Outcome::Pass || tc.explored) std::cout << fmt::format("{}{}\n", std::string(38, ' '), e.reason);
     auto dist = campaign::distinguishing_branches(cb, res.executions, e);
     if (!dist.empty()) {
       std::string list;
@@ -445,6 +468,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
     for (std::string l; std::getline(lines, l);) std::cout << "  " << l << "\n";
   }
   for (const auto& l : io_report) std::cout << "  " << l << "\n";
+  if (cb.spec.explore.enabled && !print_suggestions(cb, res, out)) return 2;
 
   if (vm.count("junit")) {
     report::JunitSuite suite;
