@@ -2,11 +2,15 @@
 // campaign writes when one process runs it.
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include <boost/program_options.hpp>
 #include <fmt/format.h>
 
+#include "campaign/mutate.hpp"
 #include "campaign/parallel.hpp"
+#include "common/file.hpp"
+#include "common/json.hpp"
 #include "commands.hpp"
 #include "options.hpp"
 
@@ -14,11 +18,65 @@ namespace po = boost::program_options;
 
 namespace plcfi::cli {
 
+namespace {
+
+// The first line of a `plcfi mutate --shard` journal says {"plcfi":"mutants",...}.
+bool is_mutation_journal(const std::string& path) {
+  std::string text, err;
+  if (!common::read_file(path, common::kMaxJournalBytes, &text, &err)) return false;
+  common::Json j;
+  size_t column = 0;
+  if (!common::json_parse(text.substr(0, text.find('\n')), &j, &err, &column) || !j.is_object()) return false;
+  auto it = j.find("plcfi");
+  return it != j.end() && it->is_string() && it->get<std::string>() == "mutants";
+}
+
+int merge_mutants(const std::vector<std::string>& files, const std::string& out) {
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  const std::string path = (std::filesystem::path(out) / "mutants.jsonl").string();
+  std::string err;
+  if (!campaign::merge_mutant_journals(files, path, &err)) {
+    std::cerr << "plcfi merge: " << err << "\n";
+    return 2;
+  }
+  std::string text;
+  if (!common::read_file(path, common::kMaxJournalBytes, &text, &err)) {
+    std::cerr << "plcfi merge: " << err << "\n";
+    return 2;
+  }
+  size_t killed = 0, survived = 0, equivalent = 0;
+  std::istringstream lines(text);
+  std::string line;
+  std::getline(lines, line);  // the header
+  while (std::getline(lines, line)) {
+    common::Json j;
+    size_t column = 0;
+    if (!common::json_parse(line, &j, &err, &column) || !j.is_object() || !j.contains("status")) continue;
+    const std::string st = j["status"].is_string() ? j["status"].get<std::string>() : "";
+    if (st == "killed") ++killed;
+    else if (st == "survived") {
+      ++survived;
+      std::cout << fmt::format("  survived #{} {}:{}:{} [{}] {}\n", j.value("index", 0), j.value("file", ""), j.value("line", 0),
+                               j.value("col", 0), j.value("operator", ""), j.value("change", ""));
+    } else if (st == "equivalent") ++equivalent;
+  }
+  const size_t judged = killed + survived;
+  std::cout << fmt::format("plcfi merge: {} mutation shard journal(s): {} killed, {} survived, {} equivalent; score {:.1f} %\n",
+                           files.size(), killed, survived, equivalent,
+                           judged ? 100.0 * static_cast<double>(killed) / static_cast<double>(judged) : 100.0);
+  std::cout << "journal " << path << "\n";
+  return 0;
+}
+
+}  // namespace
+
 int cmd_merge(const std::vector<std::string>& args) {
-  const std::string usage = "plcfi merge --out DIR SHARD_FILE...";
+  const std::string usage = "plcfi merge --out DIR SHARD_FILE...   (campaign shard files, or plcfi mutate --shard journals)";
   po::options_description desc(
       "plcfi merge: combine the N shard files of a campaign (plcfi campaign --shard K/N) into DIR/results.jsonl, the "
-      "journal one process running the whole campaign writes");
+      "journal one process running the whole campaign writes; or the mutants.jsonl journals of plcfi mutate --shard K/N into "
+      "DIR/mutants.jsonl, the journal of one run");
   desc.add_options()("out", po::value<std::string>(), "output folder for results.jsonl (required)");
   po::variables_map vm;
   if (!parse_args(args, desc, vm, usage)) return 0;
@@ -28,6 +86,7 @@ int cmd_merge(const std::vector<std::string>& args) {
   }
   const auto files = vm["files"].as<std::vector<std::string>>();
   const std::string out = vm["out"].as<std::string>();
+  if (is_mutation_journal(files.front())) return merge_mutants(files, out);
   const std::string journal = (std::filesystem::path(out) / "results.jsonl").string();
   campaign::MergeResult m;
   std::string err;

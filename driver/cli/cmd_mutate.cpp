@@ -8,6 +8,7 @@
 
 #include "campaign/generate.hpp"
 #include "campaign/mutate.hpp"
+#include "campaign/parallel.hpp"
 #include "commands.hpp"
 #include "common/json.hpp"
 #include "options.hpp"
@@ -16,42 +17,16 @@ namespace po = boost::program_options;
 
 namespace plcfi::cli {
 
-namespace {
-
-// "K/N" with 0 <= K < N (shards are counted from 0).
-bool parse_shard(const std::string& s, unsigned* k, unsigned* n, std::string* err) {
-  size_t slash = s.find('/');
-  bool neg = false;
-  uint64_t a = 0, b = 0;
-  if (slash == std::string::npos || !parse_whole(s.substr(0, slash), &neg, &a) || neg ||
-      !parse_whole(s.substr(slash + 1), &neg, &b) || neg) {
-    *err = "option '--shard': '" + s + "' is not K/N (e.g. 0/2: the first of two shards)";
-    return false;
-  }
-  if (b == 0 || b > 4096) {
-    *err = "option '--shard': '" + s + "': N must be from 1 to 4096";
-    return false;
-  }
-  if (a >= b) {
-    *err = fmt::format("option '--shard': '{}': K counts from 0, so it must be below N (0..{})", s, b - 1);
-    return false;
-  }
-  *k = static_cast<unsigned>(a);
-  *n = static_cast<unsigned>(b);
-  return true;
-}
-
-}  // namespace
-
 int cmd_mutate(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi mutate CAMPAIGN.yaml [--program FILE...] [--seed N] [--jobs N] [--shard K/N] [--out DIR] [--json] [--list] [--min-score P]";
+      "plcfi mutate CAMPAIGN.yaml [--program FILE...] [--explore] [--seed N] [--jobs N] [--shard K/N] [--out DIR] [--json] [--list] [--min-score P]";
   po::options_description desc(
       "plcfi mutate: mutation analysis of the program's error handling: mutants of the compiled program (stores to alarm/stop "
       "variables removed, their guarding conditions negated, dropped or forced FALSE, timer presets scaled, latches cleared), "
       "the campaign run on each (stop at the first kill), the score and every survivor");
   desc.add_options()
       ("program", po::value<std::vector<std::string>>()->multitoken(), "program files instead of the campaign's")
+      ("explore", "judge the mutants by the explored campaign (campaign --explore): the FMEA's cases and the explored ones")
       ("seed", po::value<Count>(), "seed instead of the campaign's")
       ("jobs,j", po::value<IntIn<1, 256>>()->default_value(IntIn<1, 256>{1}, "1"), "worker processes judging mutants (same output as 1)")
       ("shard", po::value<std::string>(), "judge only the mutants with index % N == K (K from 0 to N-1); combine the journals with merge")
@@ -68,9 +43,14 @@ int cmd_mutate(const std::vector<std::string>& args) {
   campaign::MutateOptions opt;
   opt.jobs = static_cast<unsigned>(vm["jobs"].as<IntIn<1, 256>>().value);
   std::string err;
-  if (vm.count("shard") && !parse_shard(vm["shard"].as<std::string>(), &opt.shard, &opt.shards, &err)) {
-    std::cerr << "plcfi mutate: " << err << "\n";
-    return 2;
+  if (vm.count("shard")) {
+    int k = 0, n = 0;
+    if (!campaign::parse_share(vm["shard"].as<std::string>(), &k, &n, &err)) {
+      std::cerr << "plcfi mutate: --shard " << err << "\n";
+      return 2;
+    }
+    opt.shard = static_cast<unsigned>(k);
+    opt.shards = static_cast<unsigned>(n);
   }
   double min_score = -1;
   if (vm.count("min-score")) {
@@ -98,8 +78,9 @@ int cmd_mutate(const std::vector<std::string>& args) {
   }
   if (vm.count("program")) spec.programs = vm["program"].as<std::vector<std::string>>();
   if (vm.count("seed")) spec.seed = vm["seed"].as<Count>().value;
-  // Campaign options that change what runs per mutant (e.g. exploration) are set on the
-  // spec here, before the one preparation: every mutant runs the same campaign.
+  // Campaign options that change what runs per mutant are set on the spec here, before the
+  // one preparation: every mutant runs the same campaign.
+  if (vm.count("explore")) spec.explore.enabled = true;
   campaign::CampaignBuild cb;
   if (!campaign::prepare_campaign(std::move(spec), &cb, &err)) {
     std::cerr << err << (err.empty() || err.back() == '\n' ? "" : "\n");

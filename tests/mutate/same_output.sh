@@ -1,7 +1,8 @@
 #!/bin/sh
 # plcfi mutate gives the same result however it is run: --jobs 2 writes the journal and
 # the report of --jobs 1 byte for byte, and the shards 0/2 and 1/2 hold exactly the
-# single run's mutant lines, each once, under headers that name their shard.
+# single run's mutant lines, each once, under headers that name their shard; plcfi merge
+# combines them into the single run's journal.
 # usage: same_output.sh PLCFI SOURCE_DIR WORK_DIR
 set -eu
 plcfi=$1
@@ -25,6 +26,10 @@ grep -q '"shard":null' "$work/one/mutants.jsonl"
 awk 'FNR > 1' "$work/s0/mutants.jsonl" "$work/s1/mutants.jsonl" | sort -t: -k2,2n > "$work/shards.lines"
 tail -n +2 "$work/one/mutants.jsonl" > "$work/one.lines"
 cmp "$work/shards.lines" "$work/one.lines"
+# plcfi merge combines the shard journals into the single run's, byte for byte.
+"$plcfi" merge --out "$work/merged" "$work/s0/mutants.jsonl" "$work/s1/mutants.jsonl" > "$work/merge.txt"
+cmp "$work/one/mutants.jsonl" "$work/merged/mutants.jsonl"
+grep -q "score" "$work/merge.txt"
 n=$(wc -l < "$work/one.lines")
 test "$n" -gt 20
 echo "same output: $n mutants"
