@@ -10,6 +10,8 @@
 #include "campaign/mutate.hpp"
 #include "campaign/parallel.hpp"
 #include "commands.hpp"
+#include "html_campaign.hpp"
+#include "report/html.hpp"
 #include "common/json.hpp"
 #include "options.hpp"
 
@@ -19,7 +21,7 @@ namespace plcfi::cli {
 
 int cmd_mutate(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi mutate CAMPAIGN.yaml [--program FILE...] [--explore] [--seed N] [--jobs N] [--shard K/N] [--out DIR] [--json] [--list] [--min-score P]";
+      "plcfi mutate CAMPAIGN.yaml [--program FILE...] [--explore] [--seed N] [--jobs N] [--shard K/N] [--out DIR] [--json] [--list] [--min-score P] [--html DIR]";
   po::options_description desc(
       "plcfi mutate: mutation analysis of the program's error handling: mutants of the compiled program (stores to alarm/stop "
       "variables removed, their guarding conditions negated, dropped or forced FALSE, timer presets scaled, latches cleared), "
@@ -33,7 +35,8 @@ int cmd_mutate(const std::vector<std::string>& args) {
       ("out", po::value<std::string>(), "write DIR/mutants.jsonl (a header line, one line per mutant)")
       ("json", "print the journal lines instead of the text report")
       ("list", "list the mutants without running the campaign")
-      ("min-score", po::value<double>(), "exit 1 when the mutation score (percent) is below P");
+      ("min-score", po::value<double>(), "exit 1 when the mutation score (percent) is below P")
+      ("html", po::value<std::string>(), "write a self-contained HTML report (DIR/index.html): score, every mutant, survivors first, the TSD");
   po::variables_map vm;
   if (!parse_args(args, desc, vm, usage, "campaign-file")) return 0;
   if (!vm.count("campaign-file") || vm["campaign-file"].as<std::vector<std::string>>().size() != 1) {
@@ -59,6 +62,10 @@ int cmd_mutate(const std::vector<std::string>& args) {
       std::cerr << "plcfi mutate: option '--min-score': a percentage from 0 to 100\n";
       return 2;
     }
+  }
+  if (vm.count("html") && !html_dir_writable(vm["html"].as<std::string>(), &err)) {  // before the work, not after it
+    std::cerr << "plcfi mutate: " << err << "\n";
+    return 2;
   }
   if (vm.count("out")) {
     opt.out_dir = vm["out"].as<std::string>();
@@ -110,6 +117,48 @@ int cmd_mutate(const std::vector<std::string>& args) {
     if (opt.shards) std::cout << fmt::format("shard {}/{}: mutants with index % {} == {}\n", opt.shard, opt.shards, opt.shards, opt.shard);
     std::cout << campaign::mutation_report(cb, run);
     if (!opt.out_dir.empty()) std::cout << "journal " << opt.out_dir << "/mutants.jsonl\n";
+  }
+  if (vm.count("html")) {
+    // The campaign's page (header, TSD) without executions, and the mutants.
+    report::HtmlReport page = html_campaign_model(cb, campaign::CampaignResult{}, opt.out_dir, false);
+    page.rows.clear();
+    page.executions.clear();
+    page.waveform_note.clear();
+    page.suggestions.clear();
+    auto& h = page.header;
+    h.title = "Mutation analysis: campaign " + h.name;
+    h.executions = run.baseline.executions;
+    h.pass = run.baseline.pass;
+    h.fail = run.baseline.fail;
+    h.not_reached = 0;
+    h.end_reason = "mutation analysis: the campaign judged every mutant (interpreted VM)";
+    h.facts.clear();
+    const double sc = campaign::mutation_score(run);
+    h.facts.emplace_back("mutation score", sc >= 0 ? fmt::format("{:.1f} %", sc * 100.0) : "no mutant to judge");
+    h.facts.emplace_back("original", fmt::format("{} execution(s): {} PASS, {} FAIL", run.baseline.executions,
+                                                 run.baseline.pass, run.baseline.fail));
+    if (opt.shards) h.facts.emplace_back("shard", fmt::format("{}/{}: this page holds its share only", opt.shard, opt.shards));
+    for (size_t i = 0; i < run.mutants.size(); ++i) {
+      if (!run.evaluated[i]) continue;
+      const auto& m = run.mutants[i];
+      const auto& r = run.results[i];
+      report::MutantRow row;
+      row.id = fmt::format("#{} {}", m.index, campaign::mutation_op_name(m.op));
+      row.location = fmt::format("{}:{}:{}", std::filesystem::path(m.file).filename().string(), m.line, m.col);
+      row.change = m.change;
+      row.status = r.status == campaign::MutantStatus::Killed     ? report::MutantStatus::Killed
+                   : r.status == campaign::MutantStatus::Survived ? report::MutantStatus::Survived
+                                                                  : report::MutantStatus::Equivalent;
+      row.killed_by = r.killed_by;
+      row.reason = r.detail;
+      page.mutants.push_back(std::move(row));
+    }
+    const std::string dir = vm["html"].as<std::string>();
+    if (!report::write_html_report(page, dir, &err)) {
+      std::cerr << "plcfi mutate: " << err << "\n";
+      return 2;
+    }
+    std::cout << "HTML report: " << (std::filesystem::path(dir) / "index.html").string() << "\n";
   }
   double score = campaign::mutation_score(run);
   if (min_score >= 0 && score >= 0 && score * 100.0 < min_score) {

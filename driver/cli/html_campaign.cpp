@@ -1,6 +1,8 @@
 // The HTML report's model from a campaign's build, result and specs.
 #include "html_campaign.hpp"
 
+#include "campaign/explore.hpp"
+
 #include <algorithm>
 #include <filesystem>
 #include <tuple>
@@ -119,6 +121,9 @@ report::HtmlReport html_campaign_model(const campaign::CampaignBuild& cb, const 
     row.reason = "campaign interrupted before this case";
     r.rows.push_back(row);
   }
+  for (const auto& s : campaign::fmea_suggestions(cb, res.executions))
+    r.suggestions.push_back({s.component, s.failure_mode, s.effect, s.detection == "none" ? "" : s.detection, s.case_id,
+                             s.transition});
   if (!vcd) r.waveform_note = "Waveforms omitted: the campaign ran with --no-vcd, so no traces were recorded.";
 
   r.tsd_path = c.tsd.path;

@@ -517,7 +517,7 @@ std::string join(const std::vector<std::string>& v, const std::string& sep) {
 
 void header_section(const HtmlReport& r, std::string& o) {
   const auto& h = r.header;
-  o += fmt::format("<h1>Campaign {}</h1>\n", esc(h.name));
+  o += fmt::format("<h1>{}</h1>\n", esc(h.title.empty() ? "Campaign " + h.name : h.title));
   if (!h.text.empty()) o += fmt::format("<p class=\"sub\">{}</p>\n", esc(h.text));
   o += "<div class=\"cards\">\n";
   auto card = [&](const char* cls, size_t n, const char* what) {
@@ -675,10 +675,11 @@ void mutants_section(const HtmlReport& r, std::string& o) {
 std::string html_report(const HtmlReport& r) {
   std::string o = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
   o += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
-  o += fmt::format("<title>plcfi campaign {}</title>\n", esc(r.header.name));
+  o += fmt::format("<title>plcfi {}</title>\n",
+                   esc(r.header.title.empty() ? "campaign " + r.header.name : r.header.title));
   o += "<style>" + std::string(kCss) + "</style>\n</head>\n<body>\n<main>\n";
   header_section(r, o);
-  table_section(r, o);
+  if (!r.rows.empty() || r.mutants.empty()) table_section(r, o);  // a mutation page has no verdict rows
   suggestions_section(r, o);
   mutants_section(r, o);
   executions_section(r, o);

@@ -19,6 +19,7 @@ const char* html_verdict_name(HtmlVerdict v);  // "PASS", "FAIL", "NOT REACHED",
 // same bytes.
 struct HtmlHeader {
   std::string name, text;
+  std::string title;  // the page's heading; empty: "Campaign <name>"
   std::vector<std::string> programs;
   std::string plant;
   uint64_t seed = 0;

@@ -77,3 +77,30 @@ tsds=$(grep -o '<svg class="tsd"' "$out/dom.html" | wc -l)
 grep -q 'class="badge fail">FAIL<' "$out/dom.html" || fail "no FAIL verdict in the DOM"
 grep -q 'class="lane faulted"' "$out/dom.html" || fail "no faulted lane highlighted"
 echo "PASS: $page rendered ($size-byte screenshot $out/report.png), $executions waveforms, no console messages"
+
+# The explored campaign's page lists the FMEA suggestions; the mutation page lists every
+# mutant, survivors first. Both render without console messages.
+fixed=$(dirname "$campaign")/../../../st_programs/stamping/stamping_fixed.st
+"$plcfi" campaign "$campaign" --program "$fixed" --explore --out "$out/explore" --html "$out/explore/report" --quiet \
+  >"$out/explore.txt" 2>&1
+[[ $? -le 1 ]] || { cat "$out/explore.txt"; fail "plcfi campaign --explore failed"; }
+suggestions=$(($(wc -l < "$out/explore/fmea_suggestions.csv") - 1))
+(( suggestions > 0 )) || fail "the explored campaign made no FMEA suggestion"
+"$plcfi" mutate "$campaign" --program "$fixed" --html "$out/mutants" >"$out/mutate.txt" 2>&1 || { cat "$out/mutate.txt"; fail "plcfi mutate failed"; }
+for name in explore/report mutants; do
+  browse --dump-dom "file://$out/$name/index.html" >"$out/dom2.html" 2>"$out/dom2.log" || fail "chromium --dump-dom failed on $name"
+  if console_lines "$out/dom2.log"; then fail "the $name page logged console messages (above)"; fi
+  if [[ $name == mutants ]]; then
+    grep -q '<h2 id="mutants">' "$out/dom2.html" || fail "no mutants section"
+    n=$(grep -o 'class="badge survived"' "$out/dom2.html" | wc -l)
+    (( n >= 1 )) || fail "no survivor on the mutation page"
+    grep -q 'Verdicts by case and path' "$out/dom2.html" && fail "an empty verdict table on the mutation page"
+  else
+    grep -q '<h2 id="suggestions">' "$out/dom2.html" || fail "no FMEA suggestions section"
+  fi
+done
+browse --screenshot="$out/mutants.png" --window-size=1400,2000 --hide-scrollbars "file://$out/mutants/index.html" >/dev/null \
+  2>"$out/mutants.log" || fail "chromium failed on the mutation page"
+if console_lines "$out/mutants.log"; then fail "the mutation page logged console messages (above)"; fi
+echo "PASS: explored page with $suggestions FMEA suggestion(s), mutation page with its survivors ($out/mutants.png)"
+
