@@ -33,6 +33,9 @@ struct DriverOptions {
   std::function<std::string()> io_lost;
   std::vector<std::pair<rt::ImageRef, int64_t>> safe_state;
   const st::NativeCode* native = nullptr;  // run program, preconditions and monitors natively
+  // Coverage exports: when set, receives per branch id the scans of this invocation (every
+  // run: search and test windows) that took the branch (st::Machine::hits()).
+  std::vector<uint64_t>* branch_hits = nullptr;
 };
 
 struct CampaignResult {

@@ -16,6 +16,7 @@
 #include "campaign/generate.hpp"
 #include "commands.hpp"
 #include "options.hpp"
+#include "coverage_opts.hpp"
 #include "json.hpp"
 #include "report/junit.hpp"
 #include "report/puml.hpp"
@@ -231,8 +232,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("rt-priority", po::value<RtPriority>()->default_value(RtPriority{0}, "0"), "with real time: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
       ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with real time: pin the scan thread to this CPU")
       ("native", "run program, preconditions and monitors through the native tier");
+  add_coverage_export_options(desc);
   po::variables_map vm;
   if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
+  if (!check_coverage_paths(vm, "plcfi campaign")) return 2;
   CampaignBuild cb;
   std::vector<std::string> programs;
   if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
@@ -260,6 +263,8 @@ int cmd_campaign(const std::vector<std::string>& args) {
   opt.out_dir = out;
   opt.resume = vm.count("resume") > 0;
   opt.vcd = !vm.count("no-vcd");
+  std::vector<uint64_t> branch_hits;  // --lcov/--cobertura
+  if (coverage_export_wanted(vm)) opt.branch_hits = &branch_hits;
   auto progress_line = [&](const campaign::Progress& p) {
     if (!live) return;
     std::cerr << fmt::format("\r  run {:>3}  cases tested {}/{}  PASS {}  FAIL {}  t = {:.1f} s   ", p.run, p.cases_tested,
@@ -430,6 +435,9 @@ int cmd_campaign(const std::vector<std::string>& args) {
       return 2;
     }
   }
+  if (coverage_export_wanted(vm) &&
+      !write_coverage_exports(vm, *cb.build->app, branch_hits, cb.program_files, "campaign_" + c.name, "plcfi campaign"))
+    return 2;
   if (res.interrupted) {
     std::cout << "campaign incomplete (" << res.end_reason << "); finish it with --resume\n";
     return 1;
