@@ -405,6 +405,7 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
   const st::Application& app = *cb.build->app;
   rt::Runtime runtime(app, cb.schedule, backend);
   runtime.machine().set_native(opt.native);
+  runtime.machine().set_count_hits(opt.branch_hits != nullptr);
   runtime.set_safe_state(opt.safe_state);
   // Every way out of this function, errors included: the fault withdrawn (both overlays
   // cleared) and the safe output state written to the backend.
@@ -555,6 +556,7 @@ bool run_campaign_on(CampaignBuild& cb, rt::IoBackend* backend, const DriverOpti
     }
   }
   runtime.remove_hooks(&driver);
+  if (opt.branch_hits) *opt.branch_hits = runtime.machine().hits();
   if (loop.paced()) {
     out->realtime = loop.pacer().properties();
     for (const auto& line : loop.figures()) out->realtime_text += (out->realtime_text.empty() ? "" : "\n") + line;

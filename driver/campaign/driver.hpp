@@ -46,6 +46,9 @@ struct DriverOptions {
   // (Machine::taken() layout).
   std::function<bool(const Execution&)> stop_after;
   std::vector<uint64_t>* window_branches = nullptr;
+  // Coverage exports: when set, receives per branch id the scans of this invocation (every
+  // run: search and test windows) that took the branch (st::Machine::hits()).
+  std::vector<uint64_t>* branch_hits = nullptr;
 };
 
 struct CampaignResult {

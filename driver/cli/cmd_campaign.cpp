@@ -18,6 +18,7 @@
 #include "campaign/parallel.hpp"
 #include "commands.hpp"
 #include "options.hpp"
+#include "coverage_opts.hpp"
 #include "json.hpp"
 #include "html_campaign.hpp"
 #include "report/junit.hpp"
@@ -260,8 +261,10 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("jobs", po::value<IntIn<1, 256>>(), "run the tests on N worker processes; the journal is the one --jobs 1 writes")
       ("shard", po::value<std::string>(), "run share K of N (K = 0..N-1) into OUT/shard-K-of-N.jsonl; `plcfi merge` "
                                           "combines the N shard files into the campaign's journal");
+  add_coverage_export_options(desc);
   po::variables_map vm;
   if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
+  if (!check_coverage_paths(vm, "plcfi campaign")) return 2;
   const int jobs = vm.count("jobs") ? static_cast<int>(vm["jobs"].as<IntIn<1, 256>>().value) : 1;
   int shard_k = 0, shard_n = 0;
   if (vm.count("shard")) {
@@ -270,7 +273,7 @@ int cmd_campaign(const std::vector<std::string>& args) {
       std::cerr << "plcfi campaign: --shard " << why << "\n";
       return 2;
     }
-    for (const char* o : {"jobs", "resume", "junit", "html", "io", "realtime"})
+    for (const char* o : {"jobs", "resume", "junit", "html", "lcov", "cobertura", "io", "realtime"})
       if (vm.count(o)) {
         std::cerr << "plcfi campaign: --shard runs one share of an offline campaign; --" << o
                   << " does not go with it (run `plcfi merge` on the shard files, then look at the journal)\n";
@@ -278,10 +281,12 @@ int cmd_campaign(const std::vector<std::string>& args) {
       }
   }
   if (jobs > 1)
-    for (const char* o : {"io", "realtime"})
+    for (const char* o : {"io", "realtime", "lcov", "cobertura"})
       if (vm.count(o)) {
         std::cerr << "plcfi campaign: --jobs splits an offline campaign between processes; --" << o
-                  << " runs on one machine's real time: drop --jobs\n";
+                  << (std::string(o) == "io" || std::string(o) == "realtime" ? " runs on one machine's real time"
+                                                                              : " counts the scans of one process")
+                  << ": drop --jobs\n";
         return 2;
       }
   CampaignBuild cb;
@@ -326,6 +331,8 @@ int cmd_campaign(const std::vector<std::string>& args) {
   opt.out_dir = out;
   opt.resume = vm.count("resume") > 0;
   opt.vcd = !vm.count("no-vcd");
+  std::vector<uint64_t> branch_hits;  // --lcov/--cobertura
+  if (coverage_export_wanted(vm)) opt.branch_hits = &branch_hits;
   auto progress_line = [&](const campaign::Progress& p) {
     if (!live) return;
     std::cerr << fmt::format("\r  run {:>3}  cases tested {}/{}  PASS {}  FAIL {}  t = {:.1f} s   ", p.run, p.cases_tested,
@@ -531,6 +538,9 @@ int cmd_campaign(const std::vector<std::string>& args) {
     }
     std::cout << "HTML report: " << (std::filesystem::path(dir) / "index.html").string() << "\n";
   }
+  if (coverage_export_wanted(vm) &&
+      !write_coverage_exports(vm, *cb.build->app, branch_hits, cb.program_files, "campaign_" + c.name, "plcfi campaign"))
+    return 2;
   if (res.interrupted) {
     std::cout << "campaign incomplete (" << res.end_reason << "); finish it with --resume\n";
     return 1;

@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "coverage_opts.hpp"
 #include "trace_hook.hpp"
 #include "common/duration.hpp"
 #include "engine.hpp"
@@ -121,12 +122,14 @@ int cmd_sim(const std::vector<std::string>& args) {
       ("alarms", po::value<std::vector<std::string>>(), "alarm variables to report (default: BOOL globals named *Error*, *Alarm*, *Warning*, *Stop*, *Fault*)")
       ("requirements", po::value<std::string>(), "EDTL requirements (YAML) checked every scan")
       ("native", "run the program (and the monitors) through the native tier");
+  add_coverage_export_options(desc);
   po::variables_map vm;
   add_dialect_options(desc);
   if (!parse_args(args, desc, vm,
                   "plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
-                  "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml]"))
+                  "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml] [--lcov F] [--cobertura F]"))
     return 0;
+  if (!check_coverage_paths(vm, "plcfi sim")) return 2;
   std::vector<std::string> files;
   if (vm.count("program")) files = vm["program"].as<std::vector<std::string>>();
   if (vm.count("files"))
@@ -184,6 +187,7 @@ int cmd_sim(const std::vector<std::string>& args) {
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi sim"))) return 2;
   runtime.machine().set_native(native.get());
+  runtime.machine().set_count_hits(coverage_export_wanted(vm));
 
   // Alarm variables.
   std::vector<st::VarHandle> alarms;
@@ -305,6 +309,9 @@ int cmd_sim(const std::vector<std::string>& args) {
     for (const auto& v : verdicts)
       if (v.violated()) status = 1;
   }
+  if (coverage_export_wanted(vm) &&
+      !write_coverage_exports(vm, app, runtime.machine().hits(), report::coverage_files(*b), "plcfi_sim", "plcfi sim"))
+    return 2;
   if (!trap_text.empty()) {
     std::cout << "  program stopped " << trap_text << "\n";
     return 1;

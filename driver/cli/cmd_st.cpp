@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "options.hpp"
+#include "coverage_opts.hpp"
 #include "native/native.hpp"
 #include "json.hpp"
 #include "engine.hpp"
@@ -356,6 +357,7 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi test"))) return 2;
   m.set_native(native.get());
+  m.set_count_hits(coverage_export_wanted(vm));
   rt::UntilOptions uo;
   uo.timeout_ns = timeout_ns;
   uo.budget = vm["budget"].as<Count>().value;
@@ -397,6 +399,8 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
       return 2;
     }
   }
+  if (coverage_export_wanted(vm) && !write_coverage_exports(vm, app, m.hits(), report::coverage_files(b), "plcfi_test", "plcfi test"))
+    return 2;
   return rep.failures > 0 || tally.failed > 0 || !rep.reached ? 1 : 0;
 }
 
@@ -415,9 +419,11 @@ int cmd_test(const std::vector<std::string>& args) {
       ("program", po::value<std::string>(), "TcUnit: the program to scan (the one calling TcUnit.RUN()) when there is no task configuration or to run it alone")
       ("cycle-time", po::value<std::string>()->default_value("10ms"), "TcUnit: cycle time of that program")
       ("until", po::value<std::string>(), "scan the program until this ST condition holds (e.g. 'PRG_TEST.fbTest.bDone'), then report FB_ASSERT's failed assertions");
+  add_coverage_export_options(desc);
   po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--timeout 10s] [--until EXPR]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--lcov FILE] [--cobertura FILE] [--timeout 10s] [--until EXPR]")) return 0;
+  if (!check_coverage_paths(vm, "plcfi test")) return 2;
   int64_t timeout_ns = 0;
   std::string err;
   if (!rt::parse_duration(vm["timeout"].as<std::string>(), &timeout_ns, &err) || timeout_ns <= 0) {
@@ -446,6 +452,7 @@ int cmd_test(const std::vector<std::string>& args) {
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi test"))) return 2;
   m.set_native(native.get());
+  m.set_count_hits(coverage_export_wanted(vm));
   TestTally tally;
   if (!b->tests.empty()) {
     st::TestRunOptions ro;
@@ -494,6 +501,9 @@ int cmd_test(const std::vector<std::string>& args) {
       return 2;
     }
   }
+  if (coverage_export_wanted(vm) &&
+      !write_coverage_exports(vm, app, m.hits(), report::coverage_files(*b), "plcfi_test", "plcfi test"))
+    return 2;
   return tally.failed ? 1 : 0;
 }
 

@@ -142,6 +142,7 @@ struct Body {
     Label exit, cont;
   };
   std::vector<Loop> loops;
+  uint32_t arm = kNoBranch;  // the branch id whose arm is being compiled (coverage nesting)
   std::vector<std::unique_ptr<Symbol>> owned;  // This-symbols made for methods
   // Monitors: state of temporal operators (current and previous value of each argument).
   uint32_t hidden_size = 0;
@@ -258,7 +259,9 @@ class Compiler {
   void for_stmt(const ForStmt& s);
   void while_stmt(const WhileStmt& s);
   void repeat_stmt(const RepeatStmt& s);
-  uint32_t branch(SourceLoc loc, const char* kind);
+  // A coverage id for an arm (BranchPoint): `decision` holds the statement's first arm id
+  // (kNoBranch before it); the arm's body is to be compiled inside an ArmScope.
+  uint32_t branch(SourceLoc loc, const char* kind, SourceLoc stmt, uint32_t* decision, const StmtList& body);
 
   // ---- expressions, rvalues (expr.cpp)
   Val expr(const Expr& e, const Type* expected = nullptr);

@@ -7,12 +7,33 @@
 
 namespace plcfi::st::detail {
 
-uint32_t Compiler::branch(SourceLoc loc, const char* kind) {
+uint32_t Compiler::branch(SourceLoc loc, const char* kind, SourceLoc stmt, uint32_t* decision, const StmtList& body) {
   uint32_t id = static_cast<uint32_t>(app_->branches.size());
-  app_->branches.push_back(BranchPoint{loc, kind, b_ && b_->pou ? b_->pou->name : ""});
+  if (*decision == kNoBranch) *decision = id;
+  BranchPoint bp;
+  bp.loc = loc;
+  bp.kind = kind;
+  bp.pou = b_ && b_->pou ? b_->pou->name : "";
+  bp.decision = *decision;
+  bp.stmt = stmt;
+  if (!body.empty()) bp.body = body.front()->loc;
+  bp.parent = b_ ? b_->arm : kNoBranch;
+  app_->branches.push_back(std::move(bp));
   emit(Op::COV, {id});
   return id;
 }
+
+namespace {
+// The arm whose body is being compiled, for the nesting of coverage ids (BranchPoint::parent).
+struct ArmScope {
+  Body* b;
+  uint32_t saved;
+  ArmScope(Body* body, uint32_t id) : b(body), saved(body->arm) { b->arm = id; }
+  ~ArmScope() { b->arm = saved; }
+  ArmScope(const ArmScope&) = delete;
+  ArmScope& operator=(const ArmScope&) = delete;
+};
+}  // namespace
 
 void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_true) {
   Slot cs = to_slot(c, elem(TypeKind::Bool), loc);
@@ -288,6 +309,7 @@ void Compiler::assign_stmt(const AssignStmt& s) {
 
 void Compiler::if_stmt(const IfStmt& s) {
   Label end = new_label();
+  uint32_t decision = kNoBranch;
   for (size_t i = 0; i < s.arms.size(); ++i) {
     const auto& arm = s.arms[i];
     uint32_t saved = b_->temp_top;
@@ -298,13 +320,15 @@ void Compiler::if_stmt(const IfStmt& s) {
     Label next = new_label();
     if (c.ok) branch_on(c, arm.cond->loc, next, false);
     b_->temp_top = saved;
-    branch(arm.loc, i == 0 ? "IF" : "ELSIF");
-    stmts(arm.body);
+    {
+      ArmScope in(b_, branch(arm.loc, i == 0 ? "IF" : "ELSIF", s.loc, &decision, arm.body));
+      stmts(arm.body);
+    }
     if (i + 1 < s.arms.size() || s.else_body) emit(Op::JMP, {Arg::target(end.id)});
     bind(next);
   }
   if (s.else_body) {
-    branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE");
+    ArmScope in(b_, branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE", s.loc, &decision, *s.else_body));
     stmts(*s.else_body);
   }
   bind(end);
@@ -402,15 +426,18 @@ void Compiler::case_stmt(const CaseStmt& s) {
     }
     emit(Op::JMP, {Arg::target(else_label.id)});
   }
+  uint32_t decision = kNoBranch;
   for (size_t a = 0; a < s.arms.size(); ++a) {
     bind(arm_labels[a]);
-    branch(s.arms[a].loc, "CASE");
-    stmts(s.arms[a].body);
+    {
+      ArmScope in(b_, branch(s.arms[a].loc, "CASE", s.loc, &decision, s.arms[a].body));
+      stmts(s.arms[a].body);
+    }
     emit(Op::JMP, {Arg::target(end.id)});
   }
   bind(else_label);
   if (s.else_body) {
-    branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE");
+    ArmScope in(b_, branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE", s.loc, &decision, *s.else_body));
     stmts(*s.else_body);
   }
   bind(end);
@@ -451,7 +478,8 @@ void Compiler::for_stmt(const ForStmt& s) {
     if (down) emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), iv, limit});
     else emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), limit, iv});
     // Coverage records that the body ran, once per entry into the loop, not per iteration.
-    branch(s.loc, "FOR");
+    uint32_t decision = kNoBranch;
+    ArmScope in(b_, branch(s.loc, "FOR", s.loc, &decision, s.body));
     bind(body);
     b_->loops.push_back({exit, cont});
     stmts(s.body);
@@ -472,8 +500,11 @@ void Compiler::for_stmt(const ForStmt& s) {
   emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), limit, iv});
   bind(body);
   b_->loops.push_back({exit, cont});
-  branch(s.loc, "FOR");
-  stmts(s.body);
+  uint32_t decision = kNoBranch;
+  {
+    ArmScope in(b_, branch(s.loc, "FOR", s.loc, &decision, s.body));
+    stmts(s.body);
+  }
   b_->loops.pop_back();
   bind(cont);
   emit(num_op(Op::ADD_I8, st), {iv, iv, step});
@@ -489,8 +520,11 @@ void Compiler::while_stmt(const WhileStmt& s) {
   if (c.ok) branch_on(c, s.cond->loc, exit, false);
   b_->temp_top = saved;
   b_->loops.push_back({exit, top});
-  branch(s.loc, "WHILE");
-  stmts(s.body);
+  uint32_t decision = kNoBranch;
+  {
+    ArmScope in(b_, branch(s.loc, "WHILE", s.loc, &decision, s.body));
+    stmts(s.body);
+  }
   b_->loops.pop_back();
   emit(Op::JMPB, {Arg::target(top.id)});
   bind(exit);
@@ -500,8 +534,11 @@ void Compiler::repeat_stmt(const RepeatStmt& s) {
   Label top = new_label(), cont = new_label(), exit = new_label();
   bind(top);
   b_->loops.push_back({exit, cont});
-  branch(s.loc, "REPEAT");
-  stmts(s.body);
+  uint32_t decision = kNoBranch;
+  {
+    ArmScope in(b_, branch(s.loc, "REPEAT", s.loc, &decision, s.body));
+    stmts(s.body);
+  }
   b_->loops.pop_back();
   bind(cont);
   if (s.until) {

@@ -116,10 +116,20 @@ struct PouInfo {
   PouInfo* find_method(std::string_view name) const;  // searches bases too
 };
 
+inline constexpr uint32_t kNoBranch = UINT32_MAX;
+
+// One arm of a decision. An IF statement's arms (IF, ELSIF..., ELSE) and a CASE
+// statement's (one per label list, ELSE) share `decision`; a loop is a decision of its own
+// with one arm, its body. An IF or CASE without ELSE has no id for "no arm taken", a
+// FOR/WHILE none for "body skipped".
 struct BranchPoint {
   SourceLoc loc;
   std::string kind;  // IF, ELSIF, ELSE, CASE, FOR, WHILE, REPEAT
   std::string pou;
+  uint32_t decision = kNoBranch;  // branch id of the statement's first arm
+  SourceLoc stmt;                 // the statement (IF, CASE, loop keyword)
+  SourceLoc body;                 // the arm's first statement; invalid when the arm is empty
+  uint32_t parent = kNoBranch;    // the arm whose body holds the statement; none at POU level
 };
 
 struct ProgramInstance {

@@ -4,6 +4,7 @@
 #include "vm.hpp"
 #include "native/native.hpp"
 
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -92,6 +93,14 @@ void Machine::clear_taken() { std::fill(taken_.begin(), taken_.end(), 0); }
 
 void Machine::merge_coverage() {
   for (size_t i = 0; i < taken_.size(); ++i) covered_[i] |= taken_[i];
+  if (!count_hits_) return;
+  for (size_t w = 0; w < taken_.size(); ++w)
+    for (uint64_t bits = taken_[w]; bits != 0; bits &= bits - 1) ++hits_[w * 64 + static_cast<size_t>(std::countr_zero(bits))];
+}
+
+void Machine::set_count_hits(bool on) {
+  count_hits_ = on;
+  if (on) hits_.resize(app_->branches.size(), 0);
 }
 
 bool Machine::fail(TrapKind k, const uint32_t* pc, std::string msg) {

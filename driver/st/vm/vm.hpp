@@ -90,6 +90,12 @@ class Machine {
   // Cumulative coverage since construction (merged by merge_coverage()).
   const std::vector<uint64_t>& covered() const { return covered_; }
   void merge_coverage();
+  // Hit counts for coverage exports (lcov, Cobertura): while on, merge_coverage() also adds
+  // one to hits()[i] for each branch id i taken since the last clear, so a count says in
+  // how many scans (test executions, cycles) the branch was taken, not how often. Off by
+  // default: merge_coverage() then costs what it did. Restarts keep the counts.
+  void set_count_hits(bool on);
+  const std::vector<uint64_t>& hits() const { return hits_; }
 
   // Assertion bookkeeping for the test runner.
   const std::string& assert_message() const { return assert_message_; }
@@ -113,6 +119,8 @@ class Machine {
   const Application* app_;
   std::vector<uint8_t> mem_;
   std::vector<uint64_t> taken_, covered_;
+  std::vector<uint64_t> hits_;  // index = branch id; sized by set_count_hits(true)
+  bool count_hits_ = false;
   int64_t now_ns_ = 0;
   uint64_t budget_limit_ = 100'000'000;
   Trap trap_;
