@@ -463,7 +463,7 @@ bool merge_mutant_journals(const std::vector<std::string>& inputs, const std::st
   std::map<size_t, std::string> lines;
   for (const auto& path : inputs) {
     std::string text, rerr;
-    if (!common::read_file(path, 1u << 30, &text, &rerr)) {
+    if (!common::read_file(path, common::kMaxJournalBytes, &text, &rerr)) {
       *err = rerr;
       return false;
     }

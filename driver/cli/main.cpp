@@ -36,7 +36,7 @@ const std::vector<Command>& commands() {
       {"script", "run CPTest+ test scripts (.cpt) against a program and a plant model, with ASSERT_COM and link faults", plcfi::cli::cmd_script},
       {"history", "show the run history of test scripts, newest first", plcfi::cli::cmd_history},
       {"plant", "look at a plant's signals (plant info) or export the stamping plant as an FMU (plant export-fmu)", plcfi::cli::cmd_plant},
-      {"merge", "combine the shard files of a campaign (campaign --shard K/N) into its journal", plcfi::cli::cmd_merge},
+      {"merge", "combine the shard files of campaign --shard or mutate --shard into the journal of one run", plcfi::cli::cmd_merge},
       {"plant-server", "serve a plant model in real time over Modbus TCP (bench rehearsal)", plcfi::cli::cmd_plant_server},
   };
   return k;
