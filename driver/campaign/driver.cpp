@@ -284,6 +284,12 @@ class PassiveDriver final : public rt::ScanHooks {
   // A run of another share: the case and path are taken, as the injection would take
   // them, and the run ends here; its test is another process's.
   void claim(rt::Runtime& r, size_t i) {
+    take(r, i);
+    injected_ = claimed_ = done_ = true;
+  }
+
+  // Case i on the path of this scan is tested from now on: its execution record begins.
+  void take(rt::Runtime& r, size_t i) {
     const TestCase& tc = cb_.cases[i];
     ++paths_[i];
     tested_.insert({i, hash_});
@@ -295,7 +301,6 @@ class PassiveDriver final : public rt::ScanHooks {
     exec_.branches = branches_;
     exec_.run = run_;
     exec_.inject_ns = r.now();
-    injected_ = claimed_ = done_ = true;
   }
 
   void inject(rt::Runtime& r, size_t i) {
@@ -334,16 +339,7 @@ class PassiveDriver final : public rt::ScanHooks {
     state_ = 0;
     start_time_.assign(tc.reqs, -1);
     react_time_.assign(tc.reqs, -1);
-    ++paths_[i];
-    tested_.insert({i, hash_});
-    exec_ = Execution{};
-    exec_.case_id = tc.id;
-    exec_.case_index = i;
-    exec_.path = paths_[i];
-    exec_.path_hash = hash_;
-    exec_.branches = branches_;
-    exec_.run = run_;
-    exec_.inject_ns = r.now();
+    take(r, i);
     if (opt_.vcd && !opt_.out_dir.empty()) {
       exec_.vcd = fmt::format("{}_path{}.vcd", tc.id, exec_.path);
       trace_ = report::open_vcd((std::filesystem::path(opt_.out_dir) / exec_.vcd).string(), cb_.watch, &err,

@@ -173,17 +173,6 @@ bool result_from_json(const common::Json& j, MutantResult* r) {
   }
 }
 
-bool write_all(int fd, const std::string& s) {
-  size_t done = 0;
-  while (done < s.size()) {
-    ssize_t n = ::write(fd, s.data() + done, s.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    done += static_cast<size_t>(n);
-  }
-  return true;
-}
-
 // Reads one '\n'-terminated message; false at end of file.
 bool read_line(int fd, std::string* buf, std::string* line) {
   while (true) {
@@ -212,7 +201,7 @@ bool read_line(int fd, std::string* buf, std::string* line) {
     j["index"] = i;
     j["error"] = err;
     j["result"] = result_json(r);
-    if (!write_all(out, common::json_compact(j) + "\n")) _exit(3);
+    if (!common::write_all(out, common::json_compact(j) + "\n")) _exit(3);
   }
   _exit(0);
 }
@@ -270,7 +259,7 @@ bool run_parallel(CampaignBuild& cb, const Baseline& base, const std::vector<Mut
   size_t next = 0, done = 0;
   auto hand_out = [&](Worker& w) {
     if (next < todo.size()) {
-      w.busy = write_all(w.to, fmt::format("{}\n", todo[next++]));
+      w.busy = common::write_all(w.to, fmt::format("{}\n", todo[next++]));
       if (!w.busy) {
         *err = "a worker stopped taking mutants";
         ok = false;

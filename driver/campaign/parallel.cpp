@@ -40,17 +40,6 @@ RunSequencer::Limits limits_of(const CampaignBuild& cb) {
   return l;
 }
 
-bool write_all(int fd, const std::string& s) {
-  size_t done = 0;
-  while (done < s.size()) {
-    ssize_t n = ::write(fd, s.data() + done, s.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    done += static_cast<size_t>(n);
-  }
-  return true;
-}
-
 const Json* member(const Json& o, const char* k) {
   auto it = o.find(k);
   return it == o.end() ? nullptr : &*it;
@@ -328,7 +317,7 @@ void reap_all(std::vector<Worker>& w, bool kill_them) {
   o.resumed = &st;
   o.on_run = [&](const RunRecord& r) {
     if (r.kind == RunRecord::Kind::Claimed || r.run % static_cast<uint64_t>(n) != static_cast<uint64_t>(k)) return true;
-    return write_all(fd, record_json(r) + "\n");
+    return common::write_all(fd, record_json(r) + "\n");
   };
   CampaignResult res;
   std::string err;
@@ -336,7 +325,7 @@ void reap_all(std::vector<Worker>& w, bool kill_them) {
   Json last;
   if (ok) last["done"] = true;
   else last["error"] = err;
-  write_all(fd, common::json_compact(last) + "\n");
+  common::write_all(fd, common::json_compact(last) + "\n");
   ::close(fd);
   ::_exit(ok ? 0 : 2);
 }

@@ -26,6 +26,10 @@ inline constexpr int kStallTimeoutMs = 10'000;
 bool read_file(const std::string& path, size_t max_bytes, std::string* text, std::string* err,
                int stall_timeout_ms = kStallTimeoutMs);
 
+// Writes all of `data` to the file descriptor, resuming after EINTR and short writes
+// (pipes between worker processes). false when the descriptor fails or is closed.
+bool write_all(int fd, const std::string& data);
+
 // "16 MiB" for whole mebibytes, else "N bytes": the limit as a message names it.
 std::string size_text(size_t bytes);
 
