@@ -476,7 +476,8 @@ bool merge_mutant_journals(const std::vector<std::string>& inputs, const std::st
         return false;
       }
       if (line_no == 1) {
-        if (j.value("plcfi", "") != "mutants" || !j.contains("shard") || !j.contains("mutants") || !j["mutants"].is_number_unsigned()) {
+        const bool named = j.contains("plcfi") && j["plcfi"].is_string() && j["plcfi"].get<std::string>() == "mutants";
+        if (!named || !j.contains("shard") || !j.contains("mutants") || !j["mutants"].is_number_unsigned()) {
           *err = fmt::format("{}:1:1: not a plcfi mutants journal", path);
           return false;
         }

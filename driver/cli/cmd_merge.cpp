@@ -53,12 +53,15 @@ int merge_mutants(const std::vector<std::string>& files, const std::string& out)
     common::Json j;
     size_t column = 0;
     if (!common::json_parse(line, &j, &err, &column) || !j.is_object() || !j.contains("status")) continue;
-    const std::string st = j["status"].is_string() ? j["status"].get<std::string>() : "";
+    // Fields as a shard wrote them; a field of another type reads as empty, never throws.
+    auto text = [&](const char* k) { return j.contains(k) && j[k].is_string() ? j[k].get<std::string>() : std::string(); };
+    auto number = [&](const char* k) { return j.contains(k) && j[k].is_number_unsigned() ? j[k].get<uint64_t>() : 0; };
+    const std::string st = text("status");
     if (st == "killed") ++killed;
     else if (st == "survived") {
       ++survived;
-      std::cout << fmt::format("  survived #{} {}:{}:{} [{}] {}\n", j.value("index", 0), j.value("file", ""), j.value("line", 0),
-                               j.value("col", 0), j.value("operator", ""), j.value("change", ""));
+      std::cout << fmt::format("  survived #{} {}:{}:{} [{}] {}\n", number("index"), text("file"), number("line"), number("col"),
+                               text("operator"), text("change"));
     } else if (st == "equivalent") ++equivalent;
   }
   const size_t judged = killed + survived;
