@@ -54,14 +54,14 @@ int merge_mutants(const std::vector<std::string>& files, const std::string& out)
     size_t column = 0;
     if (!common::json_parse(line, &j, &err, &column) || !j.is_object() || !j.contains("status")) continue;
     // Fields as a shard wrote them; a field of another type reads as empty, never throws.
-    auto text = [&](const char* k) { return j.contains(k) && j[k].is_string() ? j[k].get<std::string>() : std::string(); };
+    auto field = [&](const char* k) { return j.contains(k) && j[k].is_string() ? j[k].get<std::string>() : std::string(); };
     auto number = [&](const char* k) { return j.contains(k) && j[k].is_number_unsigned() ? j[k].get<uint64_t>() : 0; };
-    const std::string st = text("status");
+    const std::string st = field("status");
     if (st == "killed") ++killed;
     else if (st == "survived") {
       ++survived;
-      std::cout << fmt::format("  survived #{} {}:{}:{} [{}] {}\n", number("index"), text("file"), number("line"), number("col"),
-                               text("operator"), text("change"));
+      std::cout << fmt::format("  survived #{} {}:{}:{} [{}] {}\n", number("index"), field("file"), number("line"), number("col"),
+                               field("operator"), field("change"));
     } else if (st == "equivalent") ++equivalent;
   }
   const size_t judged = killed + survived;
