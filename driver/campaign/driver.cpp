@@ -164,6 +164,10 @@ class PassiveDriver final : public rt::ScanHooks {
     int64_t t = r.now();
     monitors_->step(r.machine(), state_++, t);
     if (trace_) trace_->sample(t, r.machine());
+    if (phase_ != Phase::Test) {
+      recovery_after_scan(r, tc, t);
+      return;
+    }
     auto v = monitors_->verdicts();
     if (tc.explored) {
       explore_after_scan(r, tc, v, t);
@@ -204,9 +208,18 @@ class PassiveDriver final : public rt::ScanHooks {
       exec_.start_ns = start;
       exec_.reaction_ns = react;
       exec_.latency_ns = react - start;
-      finish(r, Outcome::Pass,
-             fmt::format("reaction {} ms after the start (deadline {})", static_cast<double>(react - start) * 1e-6,
-                         human_duration(tc.deadline_ns)));
+      std::string reason = fmt::format("reaction {} ms after the start (deadline {})", static_cast<double>(react - start) * 1e-6,
+                                       human_duration(tc.deadline_ns));
+      if (tc.recovery) {  // then the recovery: the fault withdrawn, the alarm latched, acknowledged
+        r.input_overlay().clear();
+        r.output_overlay().clear();
+        r.reapply_input_overlay();
+        phase_ = Phase::Hold;
+        withdrawn_ns_ = t;
+        reaction_reason_ = std::move(reason);
+        return;
+      }
+      finish(r, Outcome::Pass, std::move(reason));
       return;
     }
     if (r.stopped()) {
@@ -225,6 +238,66 @@ class PassiveDriver final : public rt::ScanHooks {
 
  private:
   std::string rel(int64_t t) const { return human_duration(t - exec_.inject_ns); }
+
+  // The recovery after the reaction (FaultClass::recovery): the alarm stays latched while
+  // the fault is gone, the test presses the acknowledgement, the module clears.
+  void recovery_after_scan(rt::Runtime& r, const TestCase& tc, int64_t t) {
+    const Recovery& rc = tc.cls->recovery;
+    const st::Machine& m = r.machine();
+    const std::string ack = fmt::format("{} ({})", rc.acknowledge, tc.ack_ref.text);
+    if (r.stopped()) {
+      finish(r, Outcome::Fail, reaction_reason_ + "; then the program stopped in the recovery: " + r.stop_reason());
+      return;
+    }
+    if (phase_ == Phase::Hold) {
+      if (!st::read_bool(m, tc.cleared[0])) {
+        finish(r, Outcome::Fail,
+               fmt::format("{}; then {} cleared without acknowledgement {} after the fault was withdrawn (it must stay "
+                           "latched {} until {} is pressed)",
+                           reaction_reason_, tc.cleared[0].path, human_duration(t - withdrawn_ns_), human_duration(rc.hold_ns),
+                           ack));
+        return;
+      }
+      if (t - withdrawn_ns_ < rc.hold_ns) return;
+      faults::FaultSpec press;
+      press.kind = faults::Kind::StuckAt;
+      press.value = 1;
+      press.text = "stuck_at(1)";
+      faults::InjectionContext ctx;
+      ctx.ref = tc.ack_ref;
+      ctx.baseline = tc.ack_ref.get(r.raw_inputs());
+      ctx.inject_ns = t;
+      ctx.tick_ns = r.schedule().tick_ns();
+      std::string err;
+      auto rule = faults::make_rule(press, ctx, &err);
+      if (!rule) {  // checked at generation: a BOOL input
+        error_ = tc.id + ": " + err;
+        done_ = true;
+        return;
+      }
+      r.input_overlay().add(std::move(rule));
+      r.reapply_input_overlay();
+      phase_ = Phase::Pressed;
+      pressed_ns_ = t;
+      return;
+    }
+    if (phase_ == Phase::Pressed && t - pressed_ns_ >= rc.press_ns) {
+      r.input_overlay().clear();  // released
+      r.reapply_input_overlay();
+      phase_ = Phase::Released;
+    }
+    std::string still;
+    for (const auto& h : tc.cleared)
+      if (st::read_bool(m, h)) still += (still.empty() ? "" : ", ") + h.path;
+    if (still.empty()) {
+      finish(r, Outcome::Pass,
+             fmt::format("{}; recovered {} after pressing {}", reaction_reason_, human_duration(t - pressed_ns_), ack));
+    } else if (t - pressed_ns_ >= rc.within_ns) {
+      finish(r, Outcome::Fail,
+             fmt::format("{}; then not recovered: {} still TRUE {} after pressing {} (fault withdrawn {} before the press)",
+                         reaction_reason_, still, human_duration(rc.within_ns), ack, human_duration(rc.hold_ns)));
+    }
+  }
 
   // The verdict of an explored case: its class's forbidden reactions (monitors), then the
   // exploration oracle (detected or tolerated, explore.hpp).
@@ -356,6 +429,7 @@ class PassiveDriver final : public rt::ScanHooks {
         if (start_time_[k] >= 0 && (exec_.start_ns < 0 || start_time_[k] < exec_.start_ns)) exec_.start_ns = start_time_[k];
     exec_.outcome = o;
     exec_.reason = std::move(reason);
+    phase_ = Phase::Test;
     exec_.end_ns = r.now();
     // Completion: withdraw the fault at once; the caller restarts program and plant.
     r.input_overlay().clear();
@@ -382,6 +456,10 @@ class PassiveDriver final : public rt::ScanHooks {
   uint64_t run_ = 0;
   size_t active_ = SIZE_MAX;
   bool done_ = false, injected_ = false, claimed_ = false;
+  enum class Phase { Test, Hold, Pressed, Released };  // the recovery's phases after the reaction
+  Phase phase_ = Phase::Test;
+  int64_t withdrawn_ns_ = 0, pressed_ns_ = 0;
+  std::string reaction_reason_;
   uint64_t state_ = 0;
   std::unique_ptr<monitor::MonitorSet> monitors_;
   std::unique_ptr<ExploreOracle> oracle_;  // explored cases only

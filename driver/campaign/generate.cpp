@@ -386,6 +386,37 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
     auto h = st::resolve(app, a, &e);
     if (h) out->watch.push_back(*h);
   }
+
+  // Recovery after the reaction: the acknowledgement input and the variables it clears.
+  for (auto& tc : out->cases) {
+    const Recovery& rc = tc.cls->recovery;
+    if (!rc.enabled || tc.explored || !tc.row) continue;
+    const std::string where = rc.loc.str() + ": class " + tc.cls->id + ": recovery: ";
+    const Lifeline* l = c.tsd.find(rc.acknowledge);
+    const std::string ack = l ? l->bind : rc.acknowledge;
+    if (!rt::parse_image_ref(app, ack, &tc.ack_ref, &e)) {
+      *err = where + "acknowledge: " + e;
+      return false;
+    }
+    if (tc.ack_ref.area != 'I' || !is_bool(tc.ack_ref.type)) {
+      *err = where + "acknowledge: '" + rc.acknowledge + "' is not a BOOL input (%IX): the test presses it like a push-button";
+      return false;
+    }
+    tc.ack_ref.text = address_text(tc.ack_ref);
+    tc.cleared.clear();
+    std::vector<std::string> names{tc.row->alarm};
+    names.insert(names.end(), rc.cleared.begin(), rc.cleared.end());
+    for (const auto& v : names) {
+      auto h = st::resolve(app, v, &e);
+      if (!h || !is_bool(h->type)) {
+        *err = where + "cleared: " + (h ? "'" + v + "' is not a BOOL" : e);
+        return false;
+      }
+      h->path = v;
+      tc.cleared.push_back(*h);
+    }
+    tc.recovery = true;
+  }
   return true;
 }
 

@@ -42,6 +42,11 @@ struct TestCase {
   // This case's requirements in CampaignBuild::monitors: [first_req, first_req + reqs),
   // the class requirements first, then one per forbidden reaction.
   size_t first_req = 0, reqs = 0, forbidden = 0;
+  // The class's recovery (FaultClass::recovery), resolved on the built program; FMEA
+  // cases only (an explored case ends at its verdict).
+  bool recovery = false;
+  rt::ImageRef ack_ref;                 // the acknowledgement input the test presses
+  std::vector<st::VarHandle> cleared;   // the alarm first, then the class's cleared variables
   std::string expected;  // readable: "gStampCylError AND gStampStop within 600 ms of StampDown"
   // Explored cases: the step's index in ExplorePlan::steps.
   size_t explore_step = 0;

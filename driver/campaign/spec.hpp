@@ -99,12 +99,27 @@ struct Forbidden {
   std::string text;
 };
 
+// After the reaction, a class may ask for the recovery too: the fault is withdrawn, the
+// alarm must stay latched for `hold`, the test presses the acknowledgement input for
+// `press`, and within `within` of the press the alarm and every `cleared` variable must be
+// FALSE.
+struct Recovery {
+  bool enabled = false;
+  std::string acknowledge;  // an input: a TSD lifeline, a variable located at %I, or a %IX address
+  int64_t hold_ns = 1'000'000'000;
+  int64_t press_ns = 200'000'000;
+  int64_t within_ns = 1'000'000'000;
+  std::vector<std::string> cleared;  // BOOL variables besides the alarm
+  Loc loc;
+};
+
 struct FaultClass {
   std::string id, name, text;
   int64_t reaction_time_ns = 0;
   int64_t max_duration_ns = 30'000'000'000;
   std::vector<ClassRequirement> requirements;
   std::vector<Forbidden> forbidden;
+  Recovery recovery;
   Loc loc;
 };
 

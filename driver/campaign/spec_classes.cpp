@@ -12,7 +12,8 @@ void parse_classes(const common::YamlDoc& f, FaultClasses* out) {
   f.check_keys(f.root(), {"fault_classes"}, "a fault-class file");
   out->path = f.path();
   for (const auto& n : f.list(f.required(f.root(), "fault_classes", "a fault-class file"), "fault_classes")) {
-    f.check_keys(n, {"id", "name", "text", "reaction_time", "max_duration", "requirements", "forbidden"}, "a fault class");
+    f.check_keys(n, {"id", "name", "text", "reaction_time", "max_duration", "requirements", "forbidden", "recovery"},
+                 "a fault class");
     FaultClass c;
     c.loc = loc_of(f, n);
     YAML::Node idn = f.required(n, "id", "a fault class");
@@ -56,6 +57,18 @@ void parse_classes(const common::YamlDoc& f, FaultClasses* out) {
         }
         c.forbidden.push_back(fo);
       }
+    }
+    if (YAML::Node rn = n["recovery"]) {
+      f.check_keys(rn, {"acknowledge", "hold", "press", "within", "cleared"}, "a class's recovery");
+      Recovery& rc = c.recovery;
+      rc.enabled = true;
+      rc.loc = loc_of(f, rn);
+      rc.acknowledge = f.scalar(f.required(rn, "acknowledge", "a class's recovery"), "acknowledge");
+      if (rn["hold"]) rc.hold_ns = f.duration(rn["hold"], "hold");
+      if (rn["press"]) rc.press_ns = f.duration(rn["press"], "press", 1);
+      if (rn["within"]) rc.within_ns = f.duration(rn["within"], "within", 1);
+      if (YAML::Node cn = rn["cleared"])
+        for (const auto& x : f.list(cn, "cleared (variables)", true)) rc.cleared.push_back(f.scalar(x, "cleared"));
     }
     out->classes.push_back(c);
   }

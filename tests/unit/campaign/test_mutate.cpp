@@ -244,10 +244,15 @@ TEST(Mutate, StampingJournalSameWithWorkersAndMergedShards) {
       EXPECT_EQ(one.results[i].executions, 1u);  // stopped at the first kill
       saw_kill = true;
     }
-    if (m.change == "`gStampStop := FALSE;` removed") {  // the acknowledgement: no case presses AckButton
+    if (m.change == "`gStampStop := FALSE;` removed") {  // the class's recovery acknowledges: the stop stays
+      EXPECT_EQ(one.results[i].status, MutantStatus::Killed);
+      EXPECT_NE(one.results[i].detail.find("not recovered: gStampStop still TRUE"), std::string::npos)
+          << one.results[i].detail;
+    }
+    if (m.change == "`PressureSetpoint := 0;` removed" && m.line == 272) {  // the step actions' default, also the safe state's
       EXPECT_EQ(one.results[i].status, MutantStatus::Survived);
-      EXPECT_FALSE(one.results[i].reached);
-      EXPECT_NE(one.results[i].detail.find("no test window executed stamping_fixed.st:257"), std::string::npos);
+      EXPECT_TRUE(one.results[i].reached);
+      EXPECT_NE(one.results[i].detail.find("PressureSetpoint also written"), std::string::npos);
       saw_survivor = true;
     }
   }
