@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace plcfi::fuzz {
 
@@ -47,6 +48,20 @@ inline std::string write_temp(const std::string& name, std::string_view data) {
 
 inline std::string_view as_text(const uint8_t* data, size_t size) {
   return {reinterpret_cast<const char*>(data), size};
+}
+
+// Up to `max` files from one input, separated by NUL bytes, written as
+// temp_dir()/<stem><i>.jsonl; their paths (targets that read several files at once).
+inline std::vector<std::string> write_temp_files(std::string_view text, const std::string& stem, size_t max) {
+  std::vector<std::string> files;
+  for (size_t begin = 0; files.size() < max;) {
+    size_t end = text.find('\0', begin);
+    std::string_view part = text.substr(begin, end == std::string_view::npos ? std::string_view::npos : end - begin);
+    files.push_back(write_temp(stem + std::to_string(files.size()) + ".jsonl", part));
+    if (end == std::string_view::npos) break;
+    begin = end + 1;
+  }
+  return files;
 }
 
 // Copies a repository file into temp_dir() (a reader follows references relative to the file).
