@@ -396,12 +396,8 @@ std::string mutant_line(const Mutant& m, const MutantResult& r) {
   j["col"] = m.col;
   j["variable"] = m.variable;
   j["change"] = m.change;
-  j["status"] = mutant_status_name(r.status);
-  j["kill"] = r.kill;
-  j["killed_by"] = r.killed_by;
-  j["detail"] = r.detail;
-  j["executions"] = r.executions;
-  j["reached"] = r.reached;
+  const common::Json result = result_json(r);
+  for (auto it = result.begin(); it != result.end(); ++it) j[it.key()] = *it;  // the result's fields, in their order
   return common::json_compact(j);
 }
 

@@ -175,6 +175,7 @@ bool RunSequencer::feed(const RunRecord& rec, Fed* out, std::string* err) {
   line["scans"] = pr_.scans;
   out->executed = true;
   out->line = common::json_compact(line);
+  out->object = std::move(line);
   check_end();
   return true;
 }
@@ -402,11 +403,8 @@ bool run_campaign_jobs(CampaignBuild& cb, int jobs, const DriverOptions& opt, Ca
         continue;
       }
       if (journal.is_open() && !journal.append_line(fed.line, err)) return fail(*err);
-      Json j;
-      size_t column = 0;
       Execution e;
-      if (!common::json_parse(fed.line, &j, &why, &column) || !parse_execution(j, cb.cases, &e, &why))
-        return fail("worker record: " + why);
+      if (!parse_execution(fed.object, cb.cases, &e, &why)) return fail("worker record: " + why);
       out->executions.push_back(e);
       if (opt.on_verdict) opt.on_verdict(out->executions.back(), seq.progress());
     }
@@ -451,14 +449,16 @@ bool run_campaign_jobs(CampaignBuild& cb, int jobs, const DriverOptions& opt, Ca
         Json j;
         std::string why;
         size_t column = 0;
-        if (common::json_parse(line, &j, &why, &column) && j.is_object() && member(j, "done")) {
-          x.done = true;
-          continue;
-        }
-        if (common::json_parse(line, &j, &why, &column) && j.is_object() && member(j, "error")) {
-          std::string msg;
-          get_string(j, "error", &msg);
-          return fail(msg);
+        if (common::json_parse(line, &j, &why, &column) && j.is_object()) {
+          if (member(j, "done")) {
+            x.done = true;
+            continue;
+          }
+          if (member(j, "error")) {
+            std::string msg;
+            get_string(j, "error", &msg);
+            return fail(msg);
+          }
         }
         RunRecord rec;
         if (!parse_record(line, &rec, &why)) return fail(fmt::format("worker {}: {}", who[i], why));
@@ -615,9 +615,22 @@ bool merge_shards(const std::vector<std::string>& files, const std::string& jour
         std::string journal;
         int64_t k = -1, nn = 0;
         if (!get_string(j, "journal", &journal) || journal != kShardJournal || !get_i64(j, "shard", &k) ||
-            !get_i64(j, "shards", &nn) || nn < 1 || k < 0 || k >= nn || !member(j, "header") ||
-            !member(j, "case_ids")) {
+            !get_i64(j, "shards", &nn) || nn < 1 || k < 0 || k >= nn) {
           *err = path + ":1:1: not a plcfi campaign shard file (written by plcfi campaign --shard K/N)";
+          return false;
+        }
+        // The campaign's limits and cases, as a shard writes them.
+        int64_t budget = 0, tick = 0, window = 0, paths = 0;
+        std::string name;
+        const Json* ids = member(j, "case_ids");
+        bool ok = get_i64(j, "budget_ns", &budget) && budget > 0 && get_i64(j, "tick_ns", &tick) && tick > 0 &&
+                  get_i64(j, "search_window_ns", &window) && window > 0 && get_i64(j, "max_paths", &paths) &&
+                  paths >= 1 && paths <= 1'000'000 && get_string(j, "campaign", &name) && get_string(j, "header", &name) &&
+                  ids && ids->is_array();
+        for (size_t i = 0; ok && i < ids->size(); ++i) ok = (*ids)[i].is_string();
+        if (!ok) {
+          *err = path + ":1:1: the shard header lacks the campaign's limits or cases (budget_ns, tick_ns, search_window_ns, "
+                        "max_paths > 0, campaign, header, case_ids): not written by plcfi campaign --shard";
           return false;
         }
         head = j;
@@ -718,9 +731,7 @@ bool merge_shards(const std::vector<std::string>& files, const std::string& jour
     journal += fed.line + "\n";
     if (!rec.exec.vcd.empty()) traces.emplace_back(std::filesystem::path(s.path).parent_path() / rec.exec.vcd);
     seen[rec.exec.case_index] = true;
-    Json j;
-    size_t column = 0;
-    common::json_parse(fed.line, &j, &why, &column);
+    const Json& j = fed.object;
     MergedExecution m;
     m.case_id = rec.exec.case_id;
     m.path = rec.exec.path;

@@ -48,6 +48,7 @@ class RunSequencer {
   struct Fed {
     bool executed = false;  // the run ends with an execution: its journal line follows
     std::string line;       // with campaign_ns and scans of the campaign so far
+    common::Json object;    // the same line, parsed
   };
   // Takes the record of run next_run(), as its owner saw it (Executed or Ended). false and
   // *err when the record cannot be that run's (another run, an inconsistent budget end).

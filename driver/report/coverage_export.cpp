@@ -1,6 +1,7 @@
 // Branch coverage as lcov tracefile and Cobertura XML (see coverage_export.hpp for what
 // the numbers mean).
 #include "coverage_export.hpp"
+#include "junit.hpp"  // xml_escape
 
 #include <algorithm>
 #include <cctype>
@@ -126,21 +127,6 @@ std::string lcov_tracefile(const std::vector<FileCoverage>& files, const std::st
 }
 
 namespace {
-
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string rate(size_t part, size_t whole) { return whole ? fmt::format("{:.4f}", static_cast<double>(part) / whole) : "1"; }
 

@@ -104,6 +104,13 @@ head -n 3 "$d"/shard1/shard-1-of-3.jsonl > "$work/cut.jsonl"
 expect_error "cut.jsonl: incomplete: no closing line" merge --out "$work/m4" "$d"/shard0/shard-0-of-3.jsonl "$work/cut.jsonl" \
   "$d"/shard2/shard-2-of-3.jsonl
 expect_error "results.jsonl:1:1: not a plcfi campaign shard file" merge --out "$work/m5" "$d/single/results.jsonl"
+# Hostile inputs: a folder, an endless file, a header with a zero tick and no cases.
+expect_error "is a directory" merge --out "$work/m6" "$work"
+expect_error "/dev/zero: is larger than" merge --out "$work/m7" /dev/zero
+printf '%s\n%s\n' '{"journal":"plcfi campaign shard","shard":0,"shards":1,"header":"x","case_ids":[],"budget_ns":-5,"tick_ns":0}' \
+  '{"complete":true}' > "$work/odd.jsonl"
+expect_error "odd.jsonl:1:1: the shard header lacks the campaign's limits" merge --out "$work/m8" "$work/odd.jsonl"
+expect_error "not K/N" campaign "$stamping/campaign.yaml" --shard -1/2
 expect_error "K must be 0..2" campaign "$stamping/campaign.yaml" --shard 3/3
 expect_error "not K/N" campaign "$stamping/campaign.yaml" --shard 1
 sed 's/^restart: cold/restart: warm/' "$work/budget_1s/campaign.yaml" > "$work/budget_1s/campaign_warm.yaml"
