@@ -414,8 +414,8 @@ int64_t read_int(const Machine& m, const VarHandle& h) {
     case Storage::U16: return load_as<uint16_t>(p);
     case Storage::U32: return load_as<uint32_t>(p);
     case Storage::U64: return static_cast<int64_t>(load_as<uint64_t>(p));
-    case Storage::F32: return static_cast<int64_t>(std::llround(load_as<float>(p)));
-    case Storage::F64: return static_cast<int64_t>(std::llround(load_as<double>(p)));
+    case Storage::F32: return static_cast<int64_t>(std::nearbyint(load_as<float>(p)));
+    case Storage::F64: return static_cast<int64_t>(std::nearbyint(load_as<double>(p)));
     default: return 0;
   }
 }
@@ -457,7 +457,7 @@ void write_int(Machine& m, const VarHandle& h, int64_t v) {
 void write_real(Machine& m, const VarHandle& h, double v) {
   if (h.type->kind == TypeKind::Real) store_as<float>(m.mem() + h.addr, static_cast<float>(v));
   else if (h.type->kind == TypeKind::LReal) store_as<double>(m.mem() + h.addr, v);
-  else write_int(m, h, static_cast<int64_t>(std::llround(v)));
+  else write_int(m, h, static_cast<int64_t>(std::nearbyint(v)));
 }
 
 namespace {

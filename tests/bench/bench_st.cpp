@@ -191,7 +191,7 @@ constexpr Expect kExpected[] = {
     {"state_machine", false, 154228, 0},
     {"int_loop", false, 17562871, 0},
     {"real_math", true, 0, 113833.73635594684},
-    {"array_struct", false, 1538515, 0},
+    {"array_struct", false, 1538511, 0},
     {"fb_calls", false, 4603772, 0},
 };
 

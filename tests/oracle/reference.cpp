@@ -1,6 +1,6 @@
 // The reference evaluator: IEC 61131-3 semantics written plainly over the parsed AST, with
 // plcfi's documented choices where the standard leaves them open (wraparound, REAL_TO_INT
-// halves away from zero and saturating, string functions clamping their lengths).
+// halves to even and saturating, string functions clamping their lengths).
 #include "reference.hpp"
 
 #include <cmath>
@@ -696,6 +696,10 @@ Value Reference::binary(st::BinaryOp op, const Value& a, const Value& b) {
         case B::Mul: v.i = norm(t, ua * ub); return v;
         case B::Div:
         case B::Mod:
+          if (b.i == 0 && op == B::Mod) {  // IEC 61131-3: IN1 MOD 0 = 0
+            v.i = 0;
+            return v;
+          }
           if (b.i == 0) throw RefTrap("division by zero");
           if (sign) {
             if (b.i == -1) v.i = op == B::Div ? norm(t, uint64_t{0} - ua) : 0;
@@ -763,11 +767,11 @@ Value Reference::convert(const Value& v, const RType* to) {
         return r;
       }
       if (from == VK::Real) {
-        r.i = saturate<float>(std::round(static_cast<float>(v.r)), to);
+        r.i = saturate<float>(std::nearbyint(static_cast<float>(v.r)), to);
         return r;
       }
       if (from == VK::LReal) {
-        r.i = saturate<double>(std::round(v.r), to);
+        r.i = saturate<double>(std::nearbyint(v.r), to);
         return r;
       }
       break;

@@ -383,7 +383,8 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
       return slot_val(to, to_dur_ms ? mul(x, 1'000'000, Op::MUL_I8) : x);
     }
     case ConversionKind::Round: {
-      // REAL_TO_INT rounds to the nearest integer, halves away from zero.
+      // REAL_TO_INT rounds to the nearest integer, exact halves to the even one (IEC 61131-3
+      // Table 22, the IEC 60559 convention: REAL_TO_INT(2.5) = 2).
       Slot t = temp_for(from);
       emit(fk == TypeKind::Real ? Op::ROUND_F32 : Op::ROUND_F64, {t, s});
       def(t);

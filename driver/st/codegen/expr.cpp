@@ -844,7 +844,10 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
       if (t->is_real()) return op_error();
       Slot d = temp_for(t);
       mark(e.loc);
-      emit(int_op(Op::MOD_I8, t->storage()), {d, a, b});
+      // x MOD 0: IEC 61131-3 defines 0; CODESYS and TwinCAT stop the task with a
+      // division-by-zero exception, which the VM's trap reproduces.
+      Op mod = opt_.dialect == Dialect::Iec ? Op::MODZ_I8 : Op::MOD_I8;
+      emit(int_op(mod, t->storage()), {d, a, b});
       def(d);
       Val v;
       v.type = t;

@@ -468,6 +468,8 @@ class Translator {
     else if (fam == "MOD")
       s = fmt::format("{0} d = {1}; if (d == ({0})0) TRAP(1, {2}u, 1, 0, 0); ", C, R(C, 3), pc) +
           W(C, 1, fmt::format("(wmod<{}>({}, d))", C, R(C, 2)));
+    else if (fam == "MODZ")
+      s = fmt::format("{0} d = {1}; ", C, R(C, 3)) + W(C, 1, fmt::format("(d == ({0})0 ? ({0})0 : wmod<{0}>({1}, d))", C, R(C, 2)));
     else if (fam == "AND") s = W(C, 1, fmt::format("({})({} & {})", C, R(C, 2), R(C, 3)));
     else if (fam == "OR") s = W(C, 1, fmt::format("({})({} | {})", C, R(C, 2), R(C, 3)));
     else if (fam == "XOR") s = W(C, 1, fmt::format("({})({} ^ {})", C, R(C, 2), R(C, 3)));
@@ -482,7 +484,7 @@ class Translator {
     else if (fam == "LOOPUP" || fam == "LOOPDN")
       s = fmt::format("{0} v; bool ovf = __builtin_add_overflow({1}, {2}, &v); {3} if (!ovf && v {4} {5}) {{ {6}{7} }}", C,
                       R(C, 1), R(C, 2), W(C, 1, "v"), fam == "LOOPUP" ? "<=" : ">=", R(C, 3), backjump(), jump(4));
-    else if (fam == "ROUND") s = W(C, 1, fmt::format("std::round({})", R(C, 2)));
+    else if (fam == "ROUND") s = W(C, 1, fmt::format("round_even({})", R(C, 2)));
     else if (fam == "TRUNC") s = W(C, 1, fmt::format("std::trunc({})", R(C, 2)));
     else return false;
     return true;

@@ -115,7 +115,7 @@ enum class ConversionKind : uint8_t {
   ToBool,        // anything else to BOOL: nonzero is TRUE
   TimeToNumber,  // a duration (TIME in milliseconds) or date to a number
   NumberToTime,  // a number to a duration (TIME in milliseconds) or date
-  Round,         // a REAL or LREAL to an integer or bit string, halves away from zero
+  Round,         // a REAL or LREAL to an integer or bit string, halves to even (IEC 60559)
   Numeric,       // between numbers and bit strings: widening or narrowing
 };
 // The kind of conversion from `from` (an enumeration converts as its base type) to `to`;

@@ -31,10 +31,13 @@ int64_t clamp_len(int64_t v, size_t max) {
   return static_cast<int64_t>(std::min<uint64_t>(static_cast<uint64_t>(v), max));
 }
 
+// On REAL the function is computed in double and rounded once to REAL: the correctly
+// rounded result wherever libm's double function is accurate (glibc's sinf, expf, ...
+// are 1 ulp off for some arguments), and what MATIEC's generated C computes.
 #define MATH(NAME, EXPR)                                                                    \
   void NAME##_F32(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {       \
-    float x = load_as<float>(b);                                                                 \
-    float y = load_as<float>(c);                                                                 \
+    double x = load_as<float>(b);                                                                \
+    double y = load_as<float>(c);                                                                \
     (void)y;                                                                                \
     store_as<float>(a, static_cast<float>(EXPR));                                                 \
   }                                                                                         \

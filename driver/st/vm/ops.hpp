@@ -109,6 +109,13 @@ inline T ror(T v, uint64_t n) {
   if (n == 0) return v;
   return static_cast<T>(shr(v, n) | shl(v, w - n));
 }
+// REAL/LREAL to integer (IEC 61131-3 Table 22, the IEC 60559 convention): the nearest
+// integer, exact halves to the even one (2.5 -> 2, 3.5 -> 4, -2.5 -> -2). nearbyint
+// under the default rounding mode, which plcfi never changes.
+template <class T>
+inline T round_even(T v) {
+  return std::nearbyint(v);
+}
 inline float f32_bits(uint32_t b) {
   float f;
   std::memcpy(&f, &b, 4);

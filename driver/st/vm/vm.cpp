@@ -501,6 +501,11 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
     W(C, 1, wmod<C>(R(C, 2), d));                                                        \
     NEXT(3);                                                                             \
   }                                                                                      \
+  L_MODZ_##TN: {                                                                         \
+    C d = R(C, 3);                                                                       \
+    W(C, 1, d == C(0) ? C(0) : wmod<C>(R(C, 2), d));                                     \
+    NEXT(3);                                                                             \
+  }                                                                                      \
   L_AND_##TN: W(C, 1, static_cast<C>(R(C, 2) & R(C, 3))); NEXT(3);                       \
   L_OR_##TN: W(C, 1, static_cast<C>(R(C, 2) | R(C, 3))); NEXT(3);                        \
   L_XOR_##TN: W(C, 1, static_cast<C>(R(C, 2) ^ R(C, 3))); NEXT(3);                       \
@@ -544,8 +549,8 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
   PLCFI_INT_TYPES(INT_IMPL)
 #undef INT_IMPL
 
-L_ROUND_F32: W(float, 1, std::round(R(float, 2))); NEXT(2);
-L_ROUND_F64: W(double, 1, std::round(R(double, 2))); NEXT(2);
+L_ROUND_F32: W(float, 1, round_even(R(float, 2))); NEXT(2);
+L_ROUND_F64: W(double, 1, round_even(R(double, 2))); NEXT(2);
 L_TRUNC_F32: W(float, 1, std::trunc(R(float, 2))); NEXT(2);
 L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
 

@@ -5,7 +5,7 @@
 // same types: BOOL bool, INT int16_t, DINT int32_t, REAL float, LREAL double, DWORD
 // uint32_t, TIME int64_t nanoseconds. DINT arithmetic that can overflow is done in
 // uint32_t (wraps modulo 2^32 like the VM); integer / and % truncate toward zero like ST;
-// REAL_TO_DINT rounds to nearest with ties away from zero (std::lround).
+// REAL_TO_DINT rounds to nearest with ties to even (std::lrint, default rounding mode).
 //
 // Timers read `now_ns`, a clock member of each state that the benchmark sets: the first
 // scan runs at now_ns = 0 and the harness adds 10 ms (10'000'000 ns) after every scan.
@@ -226,7 +226,7 @@ inline void int_loop_scan(IntLoopState& s) {
 // real_math.st: REAL -> float, LREAL -> double; same evaluation order (left-associative);
 // SQRT on REAL -> std::sqrt(float); SIN on LREAL -> std::sin(double); REAL -> LREAL
 // widening -> static_cast<double>; LIMIT(MN, IN, MX) -> min(max(IN, MN), MX);
-// REAL_TO_DINT -> std::lround (ties away from zero).
+// REAL_TO_DINT -> std::lrint (ties to even).
 
 struct RealMathState {
   int64_t now_ns = 0;
@@ -259,7 +259,7 @@ inline void real_math_scan(RealMathState& s) {
     s.pv = s.pv + (s.u - s.pv * s.leak) * s.plantGain;
     s.phase = s.phase + s.dphase;
     s.acc = s.acc + static_cast<double>(std::sqrt(std::fabs(s.pv))) + std::sin(s.phase) * s.half;
-    s.rsum = wrap_add(s.rsum, static_cast<int32_t>(std::lround(s.u * s.ten)));
+    s.rsum = wrap_add(s.rsum, static_cast<int32_t>(std::lrint(s.u * s.ten)));
   }
   s.sp = -s.sp;
   s.result = s.acc + static_cast<double>(s.rsum);
@@ -268,7 +268,7 @@ inline void real_math_scan(RealMathState& s) {
 // ---------------------------------------------------------------- array_struct
 // array_struct.st: BenchItem -> NativeBenchItem {int32_t, int16_t, float};
 // ARRAY[1..256] -> std::array index i-1; struct assignment -> struct copy;
-// DINT_TO_REAL -> static_cast<float>; REAL_TO_DINT -> std::lround.
+// DINT_TO_REAL -> static_cast<float>; REAL_TO_DINT -> std::lrint.
 
 struct NativeBenchItem {
   int32_t value = 0;
@@ -308,7 +308,7 @@ inline void array_struct_scan(ArrayStructState& s) {
   for (int i = 2; i <= 255; ++i) {
     s.ma = (it[i - 2].value + it[i - 1].value + it[i].value) / 3;
     s.sum = wrap_add(s.sum, wrap_add(wrap_mul(s.ma, it[i - 1].weight),
-                                     static_cast<int32_t>(std::lround(it[i - 1].avg))));
+                                     static_cast<int32_t>(std::lrint(it[i - 1].avg))));
   }
   s.i = 256;
   s.result = wrap_add(s.result, s.sum) % 1000000007;

@@ -29,9 +29,9 @@ struct Pair {
   std::unique_ptr<NativeCode> native;
 };
 
-Pair build_both(const std::vector<std::pair<std::string, std::string>>& sources) {
+Pair build_both(const std::vector<std::pair<std::string, std::string>>& sources, CompileOptions opt = {}) {
   Pair p;
-  p.b = build_sources(sources, CompileOptions{});
+  p.b = build_sources(sources, opt);
   EXPECT_TRUE(p.b->ok()) << p.b->diags.render_all();
   if (!p.b->ok()) return p;
   std::string err;
@@ -101,7 +101,9 @@ TEST_P(NativeTraps, SameTrapKindLocationAndMessage) {
   const TrapCase& c = GetParam();
   std::string src = std::string("PROGRAM P\nVAR\n  n : DINT;\n  zero : DINT;\n") + c.vars + "END_VAR\nn := n + 1;\nIF n >= 3 THEN\n" +
                     c.body + "\nEND_IF;\nEND_PROGRAM\n";
-  Pair p = build_both({{"p.st", src}});
+  CompileOptions opt;
+  opt.dialect = Dialect::Codesys;  // x MOD 0 traps there (IEC: 0)
+  Pair p = build_both({{"p.st", src}}, opt);
   ASSERT_TRUE(p.native);
   EXPECT_EQ(compare_runs(p, 5), 2);
   Machine n(*p.b->app);
@@ -117,7 +119,7 @@ TEST_P(NativeTraps, SameTrapKindLocationAndMessage) {
 
 const TrapCase kTraps[] = {
     {"division", "  n := 100 / zero;", "", TrapKind::DivisionByZero},
-    {"modulo", "  n := 100 MOD zero;", "", TrapKind::DivisionByZero},
+    {"modulo", "  n := 100 MOD zero;", "", TrapKind::DivisionByZero},  // under --dialect codesys
     {"index_frame_array", "  a[n * 5] := 1;", "  a : ARRAY[1..10] OF DINT;\n", TrapKind::IndexOutOfRange},
     {"index_read", "  n := a[n - 10];", "  a : ARRAY[1..10] OF DINT;\n", TrapKind::IndexOutOfRange},
     {"index_struct_array", "  r[n * 5].x := 1;", "  r : ARRAY[1..4] OF STRUCT x : INT; y : REAL; END_STRUCT;\n",

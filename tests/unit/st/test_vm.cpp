@@ -52,8 +52,8 @@ struct VmRun {
   std::unique_ptr<Build> b;
   std::unique_ptr<Machine> m;
 
-  explicit VmRun(const std::string& src) {
-    b = build_sources({{"vm.st", src}}, CompileOptions{});
+  explicit VmRun(const std::string& src, CompileOptions opt = {}) {
+    b = build_sources({{"vm.st", src}}, opt);
     if (!b->ok()) {
       ADD_FAILURE() << b->diags.render_all();
       return;
@@ -102,8 +102,19 @@ TEST(VmTrap, IntegerDivisionByZeroAtTheDivision) {
   EXPECT_EQ(0, r.get("Main.q"));  // the trapping assignment did not happen
 }
 
-TEST(VmTrap, ModByZeroAtTheMod) {
+TEST(VmTrap, ModByZeroIsZeroAsIecDefinesIt) {
   VmRun r(kDivide);
+  ASSERT_TRUE(r.ok());
+  r.set("Main.op", 1);
+  r.set("Main.q", 99);
+  EXPECT_TRUE(r.scan());
+  EXPECT_EQ(0, r.get("Main.q"));
+}
+
+TEST(VmTrap, ModByZeroTrapsUnderCodesysAsTheTargetDoes) {
+  CompileOptions opt;
+  opt.dialect = Dialect::Codesys;
+  VmRun r(kDivide, opt);
   ASSERT_TRUE(r.ok());
   r.set("Main.op", 1);
   EXPECT_FALSE(r.scan());
@@ -427,13 +438,13 @@ TEST(VmArithmetic, UnsignedDivisionUsesUnsignedValues) {
   EXPECT_EQ(1, r.get("Main.m"));
 }
 
-TEST(VmArithmetic, RealToIntegerConversionRoundsHalfAwayFromZero) {
+TEST(VmArithmetic, RealToIntegerConversionRoundsHalvesToEven) {
   VmRun r("PROGRAM Main\nVAR x : REAL := 2.5; y : REAL := -2.5; z : LREAL := 3.5; a, b, c : DINT; END_VAR\n"
           "a := REAL_TO_DINT(x); b := REAL_TO_DINT(y); c := LREAL_TO_DINT(z);\nEND_PROGRAM\n");
   ASSERT_TRUE(r.ok());
   ASSERT_TRUE(r.scan());
-  EXPECT_EQ(3, r.get("Main.a"));
-  EXPECT_EQ(-3, r.get("Main.b"));
+  EXPECT_EQ(2, r.get("Main.a"));
+  EXPECT_EQ(-2, r.get("Main.b"));
   EXPECT_EQ(4, r.get("Main.c"));
 }
 
@@ -621,4 +632,47 @@ TEST(VmCoverage, CoveredAccumulatesAcrossScansAndReportsMisses) {
 }
 
 }  // namespace
+
+// ------------------------------------------------------------------ numerics as IEC and MATIEC
+
+TEST(VmNumerics, RealToIntRoundsHalvesToEven) {
+  VmRun r(R"(PROGRAM Main
+VAR a, b, c, d, e, f, g : DINT; x : REAL := 71598.5; END_VAR
+a := REAL_TO_DINT(2.5); b := REAL_TO_DINT(3.5); c := REAL_TO_DINT(-2.5);
+d := LREAL_TO_DINT(LREAL#-3.5); e := REAL_TO_DINT(x); f := REAL_TO_DINT(2.4999999);
+g := LREAL_TO_DINT(LREAL#0.5);
+END_PROGRAM
+)");
+  ASSERT_TRUE(r.ok());
+  ASSERT_TRUE(r.scan());
+  EXPECT_EQ(2, r.get("Main.a"));
+  EXPECT_EQ(4, r.get("Main.b"));
+  EXPECT_EQ(-2, r.get("Main.c"));
+  EXPECT_EQ(-4, r.get("Main.d"));
+  EXPECT_EQ(71598, r.get("Main.e"));
+  EXPECT_EQ(2, r.get("Main.f"));
+  EXPECT_EQ(0, r.get("Main.g"));
+}
+
+TEST(VmNumerics, RealSinIsTheDoubleResultRoundedOnce) {
+  // sinf is 1 ulp off for some arguments; SIN on REAL is (float)sin((double)x).
+  VmRun r(R"(PROGRAM Main
+VAR x : REAL; y : REAL; i : INT; bad : INT; END_VAR
+bad := 0;
+FOR i := 1 TO 2000 DO
+  x := INT_TO_REAL(i) * 0.0078125;
+  y := SIN(x);
+  IF y <> LREAL_TO_REAL(SIN(REAL_TO_LREAL(x))) THEN bad := bad + 1; END_IF;
+  y := COS(x);
+  IF y <> LREAL_TO_REAL(COS(REAL_TO_LREAL(x))) THEN bad := bad + 1; END_IF;
+  y := EXP(x * 0.125);
+  IF y <> LREAL_TO_REAL(EXP(REAL_TO_LREAL(x * 0.125))) THEN bad := bad + 1; END_IF;
+END_FOR;
+END_PROGRAM
+)");
+  ASSERT_TRUE(r.ok());
+  ASSERT_TRUE(r.scan());
+  EXPECT_EQ(0, r.get("Main.bad"));
+}
+
 }  // namespace plcfi::st
