@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -111,6 +112,7 @@ class Translator {
            "(int64_t)(b), (int64_t)(cc)); } while (0)\n";
     for (uint32_t e : ok) out << "static int f" << e << "(Ctx* c, uint8_t* base);\n";
     pass_ = 1;  // callees now known: the untranslated ones are called through the host
+    summarize();
     std::ostringstream again;
     for (uint32_t e : ok) {
       uint32_t end = next_start(e);
@@ -184,6 +186,117 @@ class Translator {
     if (native_.count(target) || (pass_ == 0 && std::binary_search(starts_.begin(), starts_.end(), target)))
       return fmt::format("f{}(c, {})", target, base_expr);
     return fmt::format("c->call_entry(c, {}u, {})", target, base_expr);
+  }
+
+  // What a function and everything it calls can do: a call into a `simple` one (no
+  // recursion, no dynamic dispatch, every callee native) needs none of the bookkeeping a
+  // general call does, once the call depth is known to fit (checked at the call).
+  struct Summary {
+    bool simple = true;
+    bool loops = false;    // backward jumps (the watchdog budget), here or below
+    bool fails = false;    // can end in a trap or a halt, here or below
+    bool methods = false;  // moves the method stack top (ENTER), here or below
+    uint32_t height = 0;   // the longest chain of calls below
+    std::vector<uint32_t> calls;  // direct callees
+    uint32_t next = 0;     // the entry the function falls into at its end (0: none)
+  };
+
+  // Instructions that never end a function early (no trap, no halt). Calls are judged by
+  // their callees' summaries; everything not named here counts as possibly failing.
+  static bool never_fails(Op op) {
+    switch (op) {
+      case Op::NOP: case Op::RET: case Op::JMP: case Op::JMPF: case Op::JMPT: case Op::JTAB: case Op::COV:
+      case Op::FBENTER: case Op::FNMOCK: case Op::FRAME: case Op::CALL: case Op::CALLA: case Op::CALLS:
+      case Op::MOV1: case Op::MOV2: case Op::MOV4: case Op::MOV8: case Op::MOVN:
+      case Op::LDG1: case Op::LDG2: case Op::LDG4: case Op::LDG8: case Op::LDGN:
+      case Op::STG1: case Op::STG2: case Op::STG4: case Op::STG8: case Op::STGN:
+      case Op::LDBIT: case Op::STBIT: case Op::ADDR: case Op::ADDRK: case Op::INITBLK: case Op::NOW: case Op::ADVTIME:
+      case Op::NATIVE: case Op::SCPY: case Op::SCMP:
+      case Op::GETBIT1: case Op::GETBIT2: case Op::GETBIT4: case Op::GETBIT8:
+      case Op::SETBIT1: case Op::SETBIT2: case Op::SETBIT4: case Op::SETBIT8:
+      case Op::BAND: case Op::BOR: case Op::BXOR: case Op::BNOT: case Op::RISE: case Op::FALL:
+      case Op::STEADY_HIGH: case Op::STEADY_LOW: case Op::TOBOOL8: case Op::TOBOOL16: case Op::TOBOOL32: case Op::TOBOOL64:
+      case Op::DIVK_I16: case Op::DIVK_I32: case Op::MODK_I16: case Op::MODK_I32:
+        return true;
+      default: break;
+    }
+    std::string_view n = op_info(op).name;
+    size_t us = n.find('_');
+    if (us == std::string_view::npos) return false;
+    std::string_view fam = n.substr(0, us), tn = n.substr(us + 1);
+    static const char* const kSafe[] = {"ADD", "SUB", "MUL", "NEG", "EQ", "NE", "LT", "LE", "GT", "GE", "JLT", "JGE",
+                                        "JEQ", "JNE", "MIN", "MAX", "ABS", "CVT", "AND", "OR", "XOR", "NOT", "SHL",
+                                        "SHR", "ROL", "ROR", "ROUND", "TRUNC", "MODZ"};
+    for (const char* f : kSafe)
+      if (fam == f) return true;
+    return fam == "DIV" && (tn == "F32" || tn == "F64");  // only integer division traps
+  }
+
+  void summarize() {
+    for (uint32_t e : native_) {
+      Summary& sm = sum_[e];
+      uint32_t end = next_start(e);
+      Op last = Op::NOP;
+      for (uint32_t pc = e; pc < end; pc += op_length(&code_[pc])) {
+        auto op = static_cast<Op>(code_[pc]);
+        last = op;
+        std::string_view n = op_info(op).name;
+        uint32_t t = 0;
+        if (op == Op::CALL || op == Op::CALLA || op == Op::CALLS) {
+          call_target(&code_[pc], &t);
+          if (native_.count(t)) sm.calls.push_back(t);
+          else sm.simple = false;
+        } else if (op == Op::CALLV || op == Op::CALLP) {
+          sm.simple = false;
+        }
+        if (op == Op::JMPB || n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) sm.loops = true;
+        if (op == Op::ENTER) sm.methods = true;
+        if (!never_fails(op)) sm.fails = true;
+      }
+      bool falls = !(last == Op::RET || last == Op::HALT || last == Op::JMP || last == Op::JMPB || last == Op::JTAB ||
+                     last == Op::TRAP);
+      if (falls && end < code_.size()) {
+        if (native_.count(end)) sm.next = end;
+        else sm.simple = false;
+      }
+    }
+    std::map<uint32_t, int> state;  // 1: being resolved, 2: done
+    std::function<void(uint32_t)> resolve = [&](uint32_t e) {
+      int& st = state[e];
+      if (st != 0) return;
+      st = 1;
+      Summary& sm = sum_[e];
+      auto take = [&](uint32_t callee, uint32_t depth) {
+        resolve(callee);
+        const Summary& o = sum_[callee];
+        if (state[callee] == 1 || !o.simple) sm.simple = false;  // recursion, or below
+        sm.loops |= o.loops;
+        sm.fails |= o.fails;
+        sm.methods |= o.methods;
+        sm.height = std::max(sm.height, o.height + depth);
+      };
+      for (uint32_t callee : sm.calls) take(callee, 1);
+      if (sm.next) take(sm.next, 0);
+      state[e] = 2;
+    };
+    for (uint32_t e : native_) resolve(e);
+  }
+
+  // A direct call (CALL, CALLA, CALLS) to `target`: to a simple function, when the
+  // depth of its deepest call fits, a plain C++ call; otherwise the general call.
+  std::string direct_call(uint32_t pc, uint32_t target, const std::string& base_expr) const {
+    std::string general = call_block(pc, callee(target, base_expr));
+    auto it = sum_.find(target);
+    if (pass_ == 0 || it == sum_.end() || !it->second.simple) return general;
+    const Summary& sm = it->second;
+    std::string call = fmt::format("f{}(c, {})", target, base_expr), fast;
+    if (sm.methods) fast += "uint32_t mt = c->mtop; ";
+    if (sm.loops) fast += "c->budget = budget; ";
+    fast += sm.fails ? fmt::format("int r = {}; ", call) : call + "; ";
+    if (sm.methods) fast += "c->mtop = mt; ";
+    if (sm.loops) fast += "budget = c->budget; ";
+    if (sm.fails) fast += "if (r) { FLUSH(); return r; } ";
+    return fmt::format("if (__builtin_expect(c->depth + {}u >= kMaxDepth, 0)) {{ {} }} else {{ {}}}", sm.height, general, fast);
   }
 
   static std::string call_block(uint32_t pc, const std::string& call) {
@@ -269,8 +382,8 @@ class Translator {
       case Op::JMPB: s = backjump() + jump(1); return true;
       case Op::JMPF: s = fmt::format("if (!{}) {}", R("uint8_t", 2), jump(1)); return true;
       case Op::JMPT: s = fmt::format("if ({}) {}", R("uint8_t", 2), jump(1)); return true;
-      case Op::CALL: s = call_block(pc, callee(w[2], fmt::format("base + {}u", w[1]))); return true;
-      case Op::CALLA: s = call_block(pc, callee(w[2], G(1))); return true;
+      case Op::CALL: s = direct_call(pc, w[2], fmt::format("base + {}u", w[1])); return true;
+      case Op::CALLA: s = direct_call(pc, w[2], G(1)); return true;
       case Op::CALLP:
         s = fmt::format("if (c->depth >= kMaxDepth) TRAP(6, {}u, 0, 0, 0); ", pc) + ptr("a", 1, "0", "8") +
             call_block(pc, callee(w[2], "mem + a"));
@@ -281,7 +394,7 @@ class Translator {
                         "c->mtop = (uint32_t)top;",
                         w[1], pc);
         return true;
-      case Op::CALLS: s = call_block(pc, callee(w[2], fmt::format("mem + {}", R("uint32_t", 1)))); return true;
+      case Op::CALLS: s = direct_call(pc, w[2], fmt::format("mem + {}", R("uint32_t", 1))); return true;
       case Op::CALLV:
         s = fmt::format("if (c->depth >= kMaxDepth) TRAP(6, {}u, 0, 0, 0); ", pc) + ptr("inst", 2, "0", "8") +
             fmt::format("uint32_t type = ld<uint16_t>(mem + inst); uint32_t entry = type < {1}u ? c->vtable[{0}u * {1}u + type] : 0; "
@@ -516,6 +629,7 @@ class Translator {
   std::vector<uint32_t> bounds_;   // every entry (function boundaries)
   std::vector<uint32_t> starts_;   // reachable entries
   std::set<uint32_t> native_;
+  std::map<uint32_t, Summary> sum_;
   int pass_ = 0;
 };
 

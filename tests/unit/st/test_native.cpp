@@ -87,6 +87,91 @@ TEST(NativeTier, BenchKernelsScanLikeTheInterpreter) {
   }
 }
 
+// Direct calls into functions that cannot recurse skip the general call's bookkeeping
+// (depth, method stack, budget, result) where their callees cannot use it; every way
+// those could still matter is compared here against the interpreter.
+const char* kCallKinds = R"(FUNCTION Leaf : DINT
+VAR_INPUT x : DINT; d : DINT; END_VAR
+Leaf := x / d;  (* traps when d = 0 *)
+END_FUNCTION
+
+FUNCTION Spin : DINT
+VAR_INPUT n : DINT; END_VAR
+VAR i : DINT; END_VAR
+FOR i := 1 TO n DO Spin := Spin + i; END_FOR;  (* the watchdog counts these *)
+END_FUNCTION
+
+FUNCTION Mid : DINT
+VAR_INPUT x : DINT; d : DINT; END_VAR
+Mid := Leaf(x := x, d := d) + Spin(n := 3);
+END_FUNCTION
+
+FUNCTION_BLOCK Acc
+VAR_INPUT x : REAL; END_VAR
+VAR_OUTPUT y : REAL; hi : BOOL; END_VAR
+y := y * 0.5 + x;
+IF y > 10.0 THEN hi := TRUE; ELSE hi := FALSE; END_IF;
+END_FUNCTION_BLOCK
+
+(* Recursion through a method: the general call, counting depth; every level also makes
+   direct calls three deep, which must fall back to the general call near the limit. *)
+FUNCTION_BLOCK Counter
+METHOD Down : DINT
+VAR_INPUT k : DINT; END_VAR
+Down := Mid(x := k, d := 1);
+IF k > 0 THEN
+  Down := Down + THIS^.Down(k := k - 1);
+END_IF;
+END_METHOD
+END_FUNCTION_BLOCK
+
+PROGRAM P
+VAR
+  n : DINT; r : DINT; a : Acc; b : Acc; c : Counter; deep : BOOL; div : DINT := 1; loops : DINT := 2;
+END_VAR
+n := n + 1;
+a(x := DINT_TO_REAL(n));
+b(x := a.y);
+deep := n = 3 OR n = 4;                   (* deeper than the call stack: CallDepth *)
+IF n = 5 THEN div := 0; END_IF;           (* a trap two calls down *)
+IF n = 7 THEN div := 1; loops := 1000000; END_IF;  (* the watchdog, in a callee *)
+IF n = 9 THEN loops := 2; END_IF;
+r := Mid(x := n, d := div) + Spin(n := loops) + c.Down(k := 20);
+IF deep THEN r := r + c.Down(k := 300); END_IF;
+END_PROGRAM
+)";
+
+TEST(NativeTier, DirectCallsKeepDepthTrapsAndTheWatchdogExact) {
+  CompileOptions opt;
+  opt.dialect = Dialect::Codesys;  // methods (THIS^) for the recursion
+  Pair p = build_both({{"calls.st", kCallKinds}}, opt);
+  ASSERT_TRUE(p.native);
+  const Application& app = *p.b->app;
+  Machine a(app), n(app);
+  a.set_budget(50'000);
+  n.set_budget(50'000);
+  n.set_native(p.native.get());
+  const auto& inst = app.programs.at(0);
+  std::vector<TrapKind> seen;
+  for (int s = 0; s < 12; ++s) {
+    bool ra = a.call(inst.pou->entry, inst.addr);
+    bool rn = n.call(inst.pou->entry, inst.addr);
+    ASSERT_EQ(ra, rn) << "scan " << s;
+    EXPECT_EQ(describe_trap(app, a.trap()), describe_trap(app, n.trap())) << "scan " << s;
+    EXPECT_EQ(0, std::memcmp(a.mem(), n.mem(), a.mem_size())) << "memory differs after scan " << s;
+    EXPECT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
+    if (!ra) seen.push_back(a.trap().kind);
+  }
+  // Each kind happened, and the tiers agreed on it.
+  EXPECT_NE(std::find(seen.begin(), seen.end(), TrapKind::CallDepth), seen.end());
+  EXPECT_NE(std::find(seen.begin(), seen.end(), TrapKind::DivisionByZero), seen.end());
+  EXPECT_NE(std::find(seen.begin(), seen.end(), TrapKind::Watchdog), seen.end());
+  // The leaf calls took the direct path.
+  std::vector<uint32_t> entries, skipped;
+  std::string src = native_source(app, &entries, &skipped);
+  EXPECT_NE(src.find("} else { int r = f"), std::string::npos) << "no direct call in the generated code";
+}
+
 // Each program traps on its 3rd scan; both tiers must report the same trap.
 struct TrapCase {
   const char* name;
