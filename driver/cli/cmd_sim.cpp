@@ -48,8 +48,11 @@ class AlarmWatch final : public rt::ScanHooks {
   explicit AlarmWatch(std::vector<st::VarHandle> vars) : vars_(std::move(vars)), prev_(vars_.size(), false),
                                                           first_(vars_.size(), -1), rises_(vars_.size(), 0) {}
   void end_of_scan(rt::Runtime& r) override {
+    const uint8_t* mem = r.machine().mem();
     for (size_t i = 0; i < vars_.size(); ++i) {
-      bool v = st::read_bool(r.machine(), vars_[i]);
+      // Every scan: a plain BOOL is one byte (the common case), the rest as the engine reads them.
+      const st::VarHandle& h = vars_[i];
+      bool v = !h.is_bit && h.type->kind == st::TypeKind::Bool ? mem[h.addr] != 0 : st::read_bool(r.machine(), h);
       if (v && !prev_[i]) {
         ++rises_[i];
         if (first_[i] < 0) first_[i] = r.now();
@@ -73,7 +76,7 @@ class AlarmWatch final : public rt::ScanHooks {
 
  private:
   std::vector<st::VarHandle> vars_;
-  std::vector<bool> prev_;
+  std::vector<uint8_t> prev_;
   std::vector<int64_t> first_;
   std::vector<uint64_t> rises_;
 };

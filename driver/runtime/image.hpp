@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,6 +29,53 @@ struct ImageRef {
   int64_t get(const uint8_t* area_base) const;
   void set(uint8_t* area_base, int64_t v) const;
 };
+
+// Called for every mapped signal in every scan: inline.
+inline int64_t ImageRef::get(const uint8_t* base) const {
+  const uint8_t* p = base + offset;
+  if (is_bit) return (*p >> bit) & 1u;
+  switch (size) {
+    case 1: return type && type->is_signed() ? static_cast<int8_t>(*p) : *p;
+    case 2: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return type && type->is_signed() ? static_cast<int16_t>(v) : v;
+    }
+    case 4: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return type && type->is_signed() ? static_cast<int32_t>(v) : v;
+    }
+    default: {
+      int64_t v;
+      std::memcpy(&v, p, 8);
+      return v;
+    }
+  }
+}
+
+inline void ImageRef::set(uint8_t* base, int64_t v) const {
+  uint8_t* p = base + offset;
+  if (is_bit) {
+    auto m = static_cast<uint8_t>(1u << bit);
+    *p = static_cast<uint8_t>(v ? (*p | m) : (*p & ~m));
+    return;
+  }
+  switch (size) {
+    case 1: *p = static_cast<uint8_t>(v); break;
+    case 2: {
+      auto x = static_cast<uint16_t>(v);
+      std::memcpy(p, &x, 2);
+      break;
+    }
+    case 4: {
+      auto x = static_cast<uint32_t>(v);
+      std::memcpy(p, &x, 4);
+      break;
+    }
+    default: std::memcpy(p, &v, 8); break;
+  }
+}
 
 // Parses "%IX0.4", "%QW2", ... (or any path resolving into the %I/%Q areas) against an
 // application's image layout. Fails with a message naming the address.

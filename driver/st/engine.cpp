@@ -399,6 +399,7 @@ std::optional<VarHandle> resolve(const Application& app, std::string_view path, 
 
 bool read_bool(const Machine& m, const VarHandle& h) {
   if (h.is_bit) return (m.mem()[h.addr] >> h.bit) & 1u;
+  if (h.type->kind == TypeKind::Bool) return m.mem()[h.addr] != 0;  // the common case, read every scan by watchers
   return read_int(m, h) != 0;
 }
 

@@ -118,7 +118,6 @@ Type* TypeTable::make(TypeKind k, std::string name) {
 }
 
 bool Type::is_integer() const { return kind >= TypeKind::SInt && kind <= TypeKind::ULInt; }
-bool Type::is_signed() const { return kind >= TypeKind::SInt && kind <= TypeKind::LInt; }
 bool Type::is_unsigned_int() const { return kind >= TypeKind::USInt && kind <= TypeKind::ULInt; }
 bool Type::is_bitstring() const { return kind >= TypeKind::Byte && kind <= TypeKind::LWord; }
 bool Type::is_real() const { return kind == TypeKind::Real || kind == TypeKind::LReal; }

@@ -71,7 +71,7 @@ struct Type {
   std::vector<uint8_t> init;
 
   bool is_integer() const;   // SINT..ULINT (and subranges of them)
-  bool is_signed() const;
+  bool is_signed() const { return kind >= TypeKind::SInt && kind <= TypeKind::LInt; }
   bool is_unsigned_int() const;
   bool is_bitstring() const;  // BYTE..LWORD
   bool is_real() const;       // REAL, LREAL
