@@ -327,7 +327,7 @@ constexpr double kTierTarget = 1.0;    // native tier <= 1.0x MATIEC
 
 // "2.41x", with " !" when it misses `target`; "-" when either side is missing.
 std::string ratio(double x, double base, double target) {
-  if (x <= 0 || base <= 0) return "-";
+  if (x <= 0 || base <= 0) return "-  ";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2fx%s", x / base, x / base > target ? " !" : "  ");
   return buf;

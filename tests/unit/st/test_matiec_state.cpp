@@ -19,6 +19,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <ostream>
 #include <sstream>
 #include <string>
 
@@ -62,6 +63,11 @@ struct Param {
   const char* kernel;
   Tier tier;
 };
+
+// gtest prints a parameter's bytes otherwise (and ctest shows them beside the test's name).
+void PrintTo(const Param& p, std::ostream* os) {
+  *os << p.kernel << (p.tier == Tier::Interpreter ? " in the interpreter" : " in the native tier");
+}
 
 std::string param_name(const ::testing::TestParamInfo<Param>& p) {
   return std::string(p.param.tier == Tier::Interpreter ? "interp_" : "native_") + p.param.kernel;
