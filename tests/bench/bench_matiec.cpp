@@ -126,68 +126,68 @@ struct Value {
   int64_t i = 0;
   double d = 0;
 };
-Value I(int64_t v) { return {v, 0}; }
-Value R(double v) { return {0, v}; }
+Value as_int(int64_t v) { return {v, 0}; }
+Value as_real(double v) { return {0, v}; }
 
 // Reads a variable named as in matiec_expected.hpp from a C++ kernel's state.
 [[noreturn]] void no_var(const char* kernel, std::string_view v) {
   die(std::string("kernel ") + kernel + ": the C++ translation has no variable " + std::string(v));
 }
 Value get(const mk::StateMachine& s, std::string_view v) {
-  if (v == "checksum") return I(s.checksum);
-  if (v == "state") return I(s.state);
-  if (v == "cycles") return I(s.cycles);
-  if (v == "batches") return I(s.batches);
-  if (v == "parts.CV") return I(s.parts.cv);
+  if (v == "checksum") return as_int(s.checksum);
+  if (v == "state") return as_int(s.state);
+  if (v == "cycles") return as_int(s.cycles);
+  if (v == "batches") return as_int(s.batches);
+  if (v == "parts.CV") return as_int(s.parts.cv);
   no_var("statemachine", v);
 }
 Value get(const mk::IntLoop& s, std::string_view v) {
-  if (v == "checksum") return I(s.checksum);
-  if (v == "acc") return I(s.acc);
-  if (v == "cnt") return I(s.cnt);
-  if (v == "mx") return I(s.mx);
-  if (v == "mix") return I(s.mix);
+  if (v == "checksum") return as_int(s.checksum);
+  if (v == "acc") return as_int(s.acc);
+  if (v == "cnt") return as_int(s.cnt);
+  if (v == "mx") return as_int(s.mx);
+  if (v == "mix") return as_int(s.mix);
   no_var("intloop", v);
 }
 Value get(const mk::RealMath& s, std::string_view v) {
-  if (v == "checksum") return I(s.checksum);
-  if (v == "energy") return R(s.energy);
-  if (v == "filt") return R(s.filt);
-  if (v == "rfilt") return R(s.rfilt);
-  if (v == "phase") return R(s.phase);
+  if (v == "checksum") return as_int(s.checksum);
+  if (v == "energy") return as_real(s.energy);
+  if (v == "filt") return as_real(s.filt);
+  if (v == "rfilt") return as_real(s.rfilt);
+  if (v == "phase") return as_real(s.phase);
   no_var("realmath", v);
 }
 Value get(const mk::Arrays& s, std::string_view v) {
-  if (v == "checksum") return I(s.checksum);
-  if (v == "sum") return I(s.sum);
-  if (v == "wsum") return I(s.wsum);
-  if (v == "isum") return I(s.isum);
-  if (v == "swaps") return I(s.swaps);
-  if (v == "seed") return I(s.seed);
+  if (v == "checksum") return as_int(s.checksum);
+  if (v == "sum") return as_int(s.sum);
+  if (v == "wsum") return as_int(s.wsum);
+  if (v == "isum") return as_int(s.isum);
+  if (v == "swaps") return as_int(s.swaps);
+  if (v == "seed") return as_int(s.seed);
   no_var("arrays", v);
 }
 Value get(const mk::FbCalls& s, std::string_view v) {
-  if (v == "checksum") return I(s.checksum);
-  if (v == "outsum") return R(s.outsum);
-  if (v == "pv[1]") return R(s.pv[0]);
-  if (v == "pv[50]") return R(s.pv[49]);
-  if (v == "satcount") return I(s.satcount);
-  if (v == "facc") return I(s.facc);
+  if (v == "checksum") return as_int(s.checksum);
+  if (v == "outsum") return as_real(s.outsum);
+  if (v == "pv[1]") return as_real(s.pv[0]);
+  if (v == "pv[50]") return as_real(s.pv[49]);
+  if (v == "satcount") return as_int(s.satcount);
+  if (v == "facc") return as_int(s.facc);
   no_var("fbcalls", v);
 }
 Value get(const mk::NestedFbs& s, std::string_view v) {
-  if (v == "checksum") return I(s.checksum);
-  if (v == "sigsum") return I(s.sigsum);
-  if (v == "cycles") return I(s.cycles);
-  if (v == "st1.step") return I(s.st[0].step);
-  if (v == "st8.ax2.moves") return I(s.st[7].ax2.moves);
+  if (v == "checksum") return as_int(s.checksum);
+  if (v == "sigsum") return as_int(s.sigsum);
+  if (v == "cycles") return as_int(s.cycles);
+  if (v == "st1.step") return as_int(s.st[0].step);
+  if (v == "st8.ax2.moves") return as_int(s.st[7].ax2.moves);
   no_var("nested_fbs", v);
 }
 Value get(const mk::Crc16& s, std::string_view v) {
-  if (v == "checksum") return I(s.checksum);
-  if (v == "crc") return I(s.crc);
-  if (v == "x8") return I(s.x8);
-  if (v == "lfsr") return I(s.lfsr);
+  if (v == "checksum") return as_int(s.checksum);
+  if (v == "crc") return as_int(s.crc);
+  if (v == "x8") return as_int(s.x8);
+  if (v == "lfsr") return as_int(s.lfsr);
   no_var("crc16", v);
 }
 
@@ -242,7 +242,7 @@ Value engine_value(const EngineKernel& k, const st::Machine& m, const mk::Expect
   std::string err;
   auto h = st::resolve(*k.build->app, "instance0." + std::string(e.name), &err);
   if (!h) die("kernel " + k.name + ": " + err);
-  return e.kind == mk::Kind::Int ? I(st::read_int(m, *h)) : R(st::read_real(m, *h));
+  return e.kind == mk::Kind::Int ? as_int(st::read_int(m, *h)) : as_real(st::read_real(m, *h));
 }
 
 template <class C>
