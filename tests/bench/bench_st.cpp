@@ -14,6 +14,8 @@
 // After the runs a table prints VM ns/scan, native ns/scan and the ratio per kernel (CPU
 // time, the minimum over repetitions when --benchmark_repetitions is given).
 //
+// The MATIEC comparison (its kernels, checks and table) is in bench_matiec.cpp.
+//
 // `plcfi_bench --disasm=<kernel>` prints the kernel's bytecode instead (for profiling).
 #include <benchmark/benchmark.h>
 #include <cstring>
@@ -34,6 +36,7 @@
 
 #include <unistd.h>
 
+#include "bench_report.hpp"
 #include "engine.hpp"
 #include "native_kernels.hpp"
 
@@ -45,6 +48,7 @@ namespace {
 
 using namespace plcfi;
 namespace nb = plcfi::bench;
+using nb::CollectingReporter;
 
 constexpr int64_t kScanNs = 10'000'000;  // 10 ms per scan, as in the native kernels
 constexpr int kCheckScans = 100;
@@ -425,35 +429,6 @@ void BM_build_stdlib_only(benchmark::State& state) {
 
 // ------------------------------------------------------------------ reporting
 
-// Console output as usual, and the per-iteration CPU time of every run (in ns) kept for
-// the summary table.
-class CollectingReporter : public benchmark::ConsoleReporter {
- public:
-  explicit CollectingReporter(OutputOptions opts) : ConsoleReporter(opts) {}
-  void ReportRuns(const std::vector<Run>& reports) override {
-    ConsoleReporter::ReportRuns(reports);
-    for (const auto& r : reports) {
-      if (r.run_type != Run::RT_Iteration || r.error_occurred || r.iterations == 0) continue;
-      double ns = r.GetAdjustedCPUTime() / benchmark::GetTimeUnitMultiplier(r.time_unit) * 1e9;
-      auto& v = best_[r.run_name.function_name];
-      v = v == 0 ? ns : std::min(v, ns);
-      auto it = r.counters.find("lines");
-      if (it != r.counters.end()) lines_[r.run_name.function_name] = it->second.value;
-    }
-  }
-  double ns(const std::string& name) const {
-    auto it = best_.find(name);
-    return it == best_.end() ? 0.0 : it->second;
-  }
-  double lines(const std::string& name) const {
-    auto it = lines_.find(name);
-    return it == lines_.end() ? 0.0 : it->second;
-  }
-
- private:
-  std::map<std::string, double> best_, lines_;
-};
-
 void print_table(const CollectingReporter& rep) {
   static const char* const kNames[] = {"state_machine", "int_loop", "real_math", "array_struct", "fb_calls"};
   bool any = false;
@@ -534,10 +509,12 @@ int main(int argc, char** argv) {
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   check_all();
   check_generated();
+  nb::check_matiec();
   std::fflush(stdout);
   CollectingReporter rep(options);
   benchmark::RunSpecifiedBenchmarks(&rep);
   print_table(rep);
+  nb::print_matiec_table(rep);
   benchmark::Shutdown();
   return 0;
 }
