@@ -172,6 +172,67 @@ TEST(NativeTier, DirectCallsKeepDepthTrapsAndTheWatchdogExact) {
   EXPECT_NE(src.find("} else { int r = f"), std::string::npos) << "no direct call in the generated code";
 }
 
+// Slots the native code keeps in locals (write-through) must be re-read wherever
+// something else may have written them: a whole-structure copy over a field, a write
+// through a reference, an FB that changes its own input, a callee in a loop, an array
+// element next to a scalar.
+const char* kCachedSlots = R"(TYPE Pair : STRUCT a : DINT; b : REAL; c : LREAL; d : DINT; END_STRUCT; END_TYPE
+
+FUNCTION_BLOCK SelfReset
+VAR_INPUT trigger : BOOL; END_VAR
+VAR_OUTPUT seen : DINT; END_VAR
+IF trigger THEN seen := seen + 1; trigger := FALSE; END_IF;
+END_FUNCTION_BLOCK
+
+FUNCTION Bump : DINT
+VAR_IN_OUT v : DINT; END_VAR
+v := v + 3;
+Bump := v;
+END_FUNCTION
+
+PROGRAM P
+VAR
+  p, q : Pair; r : REF_TO DINT; x, y, i, k : DINT; f : SelfReset; arr : ARRAY[0..3] OF DINT; z : DINT;
+END_VAR
+p.a := p.a + 1;
+q.a := p.a * 10;
+p := q;                 (* a block copy over p.a *)
+y := p.a;
+x := x + 1;
+r := REF(x);
+r^ := r^ * 2;           (* through a reference *)
+y := y + x;
+f.trigger := TRUE;
+f();                    (* the FB clears its own input *)
+IF f.trigger THEN y := y + 1000; END_IF;
+k := 0;
+FOR i := 1 TO 4 DO
+  k := k + 1;
+  y := y + Bump(v := k);  (* the callee writes k *)
+  k := k + 1;
+END_FOR;
+z := z + 1;
+arr[z MOD 4] := z;      (* an element write next to z *)
+y := y + z + arr[0] + arr[1] + arr[2] + arr[3] + k;
+END_PROGRAM
+)";
+
+TEST(NativeTier, CachedSlotsAreReadAgainAfterEveryOtherWrite) {
+  Pair p = build_both({{"cached.st", kCachedSlots}});
+  ASSERT_TRUE(p.native);
+  EXPECT_EQ(compare_runs(p, 20), -1);
+  Machine n(*p.b->app);
+  n.set_native(p.native.get());
+  const auto& inst = p.b->app->programs.at(0);
+  ASSERT_TRUE(n.call(inst.pou->entry, inst.addr));
+  std::string err;
+  auto y = resolve(*p.b->app, "P.y", &err);
+  ASSERT_TRUE(y) << err;
+  // p.a = 10, x = 2, trigger cleared, k: 1+3=4 -> 5, 6+3=9 -> 10, ... Bump results 4+9+14+19,
+  // k = 20, z = 1, arr[1] = 1.
+  EXPECT_EQ(read_int(n, *y), 10 + 2 + (4 + 9 + 14 + 19) + 1 + 1 + 20);
+}
+
 // Each program traps on its 3rd scan; both tiers must report the same trap.
 struct TrapCase {
   const char* name;
