@@ -484,10 +484,10 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
             return property_get(Place{}, g, itf.slot, e.loc);
           }
         }
-        return load(implicit_deref(member_place(base, m.member, e.loc), e.loc));
+        return load_once(implicit_deref(member_place(base, m.member, e.loc), e.loc));
       }
+      case ExprKind::Index: return load_once(place(e, false));
       case ExprKind::DirectAddr:
-      case ExprKind::Index:
       case ExprKind::Deref:
       case ExprKind::BitAccess: return load(place(e, false));
       case ExprKind::Call: {

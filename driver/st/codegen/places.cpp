@@ -381,6 +381,7 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
   }
   uint64_t const_disp = 0;
   std::vector<std::pair<size_t, Slot>> dyn;
+  uint32_t idx_cvt = UINT32_MAX;
   for (size_t i = 0; i < e.indices.size(); ++i) {
     Val v = expr(*e.indices[i], elem(TypeKind::DInt));
     if (!v.ok) return bad_place;
@@ -415,7 +416,9 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
         emit(int_op(Op::CHK_I8, v.type->storage()), {v.slot, los, his, 1u});
       }
     }
+    size_t before = b_->code.size();
     dyn.emplace_back(i, convert(v.slot, v.type, elem(TypeKind::DInt)));
+    if (b_->code.size() != before) idx_cvt = b_->last_instr;
   }
   if (dyn.empty()) {
     Place p = base;
@@ -438,6 +441,7 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     p.lo = static_cast<int32_t>(t->dims[0].lo);
     p.count = static_cast<uint32_t>(t->dims[0].hi - t->dims[0].lo + 1);
     p.stride = t->elem->is_elementary() ? 0 : esize;
+    p.idx_cvt = idx_cvt;
     p.readonly = base.readonly;
     return p;
   }
@@ -504,6 +508,46 @@ Slot Compiler::addr_of(const Place& p, SourceLoc loc) {
 }
 
 // ------------------------------------------------------------------ load/store
+
+// A read of an element of a frame array through an INT index, right after the index's
+// conversion to DINT: the element is read with the INT index itself (LDXH, LDXSH) and the
+// conversion dropped. Only for a place read once, here: another use of the place would
+// read the dropped DINT copy.
+Val Compiler::load_once(const Place& p) {
+  auto& code = b_->code;
+  uint32_t at = b_->last_instr;
+  uint32_t size = p.ok && p.type ? p.type->size : 0;
+  if (!p.ok || p.k != Place::K::FrameIdx || !p.type->is_elementary() || !(size == 1 || size == 2 || size == 4 || size == 8) ||
+      at >= code.size() || p.idx_cvt != at || code[at] != static_cast<uint32_t>(Op::CVT_I16_I32) || b_->last_def_pos != at ||
+      b_->last_label_pos > at || b_->last_def.kind != SK::Temp || p.idx.kind != SK::Temp || b_->last_def.off != p.idx.off ||
+      (!b_->lines.empty() && b_->lines.back().first > at))
+    return load(p);
+  Arg x(code[at + 2]);
+  for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
+    if (it->first == at + 2) x = Arg(Slot{code[at + 2], it->second});
+    if (it->first >= at) it = b_->slot_fix.erase(it);
+    else ++it;
+  }
+  code.resize(at);
+  b_->last_def_pos = UINT32_MAX;
+  for (auto it = b_->cvt_cache.begin(); it != b_->cvt_cache.end();) {
+    if (it->second.kind == p.idx.kind && it->second.off == p.idx.off) it = b_->cvt_cache.erase(it);
+    else ++it;
+  }
+  Slot t = temp_for(p.type);
+  if (p.stride) {
+    Op op = size == 1 ? Op::LDXSH1 : size == 2 ? Op::LDXSH2 : size == 4 ? Op::LDXSH4 : Op::LDXSH8;
+    emit(op, {t, Slot{p.off, p.sk}, x, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+  } else {
+    Op op = size == 1 ? Op::LDXH1 : size == 2 ? Op::LDXH2 : size == 4 ? Op::LDXH4 : Op::LDXH8;
+    emit(op, {t, Slot{p.off, p.sk}, x, static_cast<uint32_t>(p.lo), p.count});
+  }
+  def(t);
+  Val v;
+  v.type = p.type;
+  v.slot = t;
+  return v;
+}
 
 Val Compiler::load(const Place& p) {
   Val v;
