@@ -101,6 +101,8 @@ struct Place {
   uint32_t stride = 0;  // FrameIdx: element size (0: the value's own size, an array of scalars)
   uint32_t field = 0;   // FrameIdx: offset of the scalar inside the element
   uint32_t idx_cvt = UINT32_MAX;  // FrameIdx: where this place emitted the conversion of its index to DINT
+  bool has_idx16 = false;  // FrameIdx: idx not made yet; the index is the INT variable idx16 (stores: STXH)
+  Slot idx16;
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -317,7 +319,9 @@ class Compiler {
   Place index_place(Place base, const IndexExpr& e);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);
-  Val load_once(const Place& p);  // load of a place used only here (may fold its index conversion)
+  Val load_once(const Place& p);
+  Slot frame_idx(const Place& p);  // FrameIdx: the DINT index slot (made here when deferred)
+  bool defer_index_cvt_ = false;  // the next index_place may leave an INT variable index as it is  // load of a place used only here (may fold its index conversion)
   void store(const Place& p, Slot src);
   void assign(const Place& dst, const Val& v, SourceLoc loc);
   Slot addr_of(const Place& p, SourceLoc loc);

@@ -252,7 +252,9 @@ void Compiler::assign_stmt(const AssignStmt& s) {
         }
       }
       if (!bs || (bs->type && bs->type->kind == TypeKind::Pou && !bs->type->field(m.member.text)) || !bs) {
+        defer_index_cvt_ = !may_call(*s.rhs) && !may_call(*base_e);  // arr[i].f := e: see index_place
         Place base = place(*base_e, true);
+        defer_index_cvt_ = false;
         if (!base.ok) return;
         if (base.type->kind == TypeKind::Pou && base.type->pou && !base.type->field(m.member.text)) {
           if (PouInfo* st = base.type->pou->find_method(setter)) {
@@ -294,7 +296,9 @@ void Compiler::assign_stmt(const AssignStmt& s) {
       }
     }
   }
+  defer_index_cvt_ = !s.is_ref_assign && !may_call(*s.rhs) && !may_call(*s.lhs);  // arr[i] := e: see index_place
   Place dst = s.is_ref_assign ? place_ref(*s.lhs, true) : place(*s.lhs, true);
+  defer_index_cvt_ = false;
   if (!dst.ok) {
     expr(*s.rhs);  // still check the right-hand side
     return;

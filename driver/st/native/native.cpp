@@ -418,6 +418,25 @@ class Translator {
         s = fmt::format("if (!({} {} {})) {}", R(t, 2), rel, R(t, 3), jump(1));
         return true;
       }
+      case Op::STXH1:
+      case Op::STXH2:
+      case Op::STXH4:
+      case Op::STXH8:
+      case Op::STXSH1:
+      case Op::STXSH2:
+      case Op::STXSH4:
+      case Op::STXSH8: {
+        // STX/STXS with an INT index.
+        std::string_view nm = op_info(op).name;
+        bool structs = nm[3] == 'S';
+        int n = nm.back() - '0';
+        const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
+        s = fmt::format("int64_t i = (int64_t){0} - (int64_t){1}; if (i < 0 || i >= (int64_t){2}) TRAP(2, {3}u, {0}, 0, 0); ",
+                        R("int16_t", 2), S(3), K(4), pc);
+        std::string addr = structs ? fmt::format("base + {} + i * {} + {}", K(1), K(5), K(6)) : fmt::format("base + {} + i * {}", K(1), n);
+        s += fmt::format("st<{}>({}, {});", t, addr, R(t, structs ? 7 : 5));
+        return true;
+      }
       case Op::LDXH1:
       case Op::LDXH2:
       case Op::LDXH4:

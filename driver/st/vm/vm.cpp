@@ -624,6 +624,30 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
     W(T, 1, ld<T>(base + pc[2] + i * pc[6] + pc[7]));                                          \
     NEXT(7);                                                                                   \
   }
+#define STXH_IMPL(N, T)                                                                        \
+  L_STXH##N: {                                                                                 \
+    int64_t i = static_cast<int64_t>(R(int16_t, 2)) - static_cast<int32_t>(pc[3]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int16_t, 2), static_cast<int32_t>(pc[3]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
+    st<T>(base + pc[1] + i * N, R(T, 5));                                                      \
+    NEXT(5);                                                                                   \
+  }                                                                                            \
+  L_STXSH##N: {                                                                                \
+    int64_t i = static_cast<int64_t>(R(int16_t, 2)) - static_cast<int32_t>(pc[3]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int16_t, 2), static_cast<int32_t>(pc[3]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
+    st<T>(base + pc[1] + i * pc[5] + pc[6], R(T, 7));                                          \
+    NEXT(7);                                                                                   \
+  }
+  STXH_IMPL(1, uint8_t)
+  STXH_IMPL(2, uint16_t)
+  STXH_IMPL(4, uint32_t)
+  STXH_IMPL(8, uint64_t)
+#undef STXH_IMPL
   LDXH_IMPL(1, uint8_t)
   LDXH_IMPL(2, uint16_t)
   LDXH_IMPL(4, uint32_t)

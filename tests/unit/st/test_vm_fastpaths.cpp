@@ -322,6 +322,59 @@ TEST(VmFastPaths, IntIndexedReadsUseTheIntAndTrapWithTheSameMessage) {
   EXPECT_EQ("index -32768 outside 1..8", p.m->trap().message);
 }
 
+// Stores through an INT variable index read it at the store (STXH) only when nothing in
+// the statement can change it first: a call on the right (here one that increments the
+// index through VAR_IN_OUT) keeps the element chosen before the call.
+const char* kIntIndexStores = R"(FUNCTION Bump : DINT
+VAR_IN_OUT io : INT; END_VAR
+io := io + 1;
+Bump := 7;
+END_FUNCTION
+TYPE Pt : STRUCT x : DINT; y : INT; END_STRUCT; END_TYPE
+PROGRAM P
+VAR a : ARRAY [1..4] OF DINT; ps : ARRAY [0..3] OF Pt; i : INT := 1; j : INT; bad : INT := 4; END_VAR
+a[i] := Bump(io := i);     (* a[1] := 7, then i = 2 *)
+a[i] := i * 10;            (* a[2] := 20 *)
+ps[j].y := i + 1;          (* ps[0].y := 3 *)
+ps[j + 1].x := 5;
+a[bad] := 1;               (* traps at this line when bad is outside 1..4 *)
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, IntIndexedStoresKeepTheElementChosenBeforeACall) {
+  Prog p(kIntIndexStores);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_NE(std::string::npos, dis.find("STXH4")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("STXSH2")) << dis;
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(7, p.get("P.a[1]"));
+  EXPECT_EQ(20, p.get("P.a[2]"));
+  EXPECT_EQ(2, p.get("P.i"));
+  EXPECT_EQ(3, p.get("P.ps[0].y"));
+  EXPECT_EQ(5, p.get("P.ps[1].x"));
+  EXPECT_EQ(1, p.get("P.a[4]"));
+  p.set("P.i", 1);
+  p.set("P.bad", 5);
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ(TrapKind::IndexOutOfRange, p.m->trap().kind);
+  EXPECT_EQ("index 5 outside 1..4", p.m->trap().message);
+  EXPECT_EQ(13u, p.m->trap().loc.line);
+  p.set("P.i", 1);
+  p.set("P.bad", 4);
+  p.set("P.j", 4);  // ps[4]: the STXSH traps
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ("index 4 outside 0..3", p.m->trap().message);
+  EXPECT_EQ(11u, p.m->trap().loc.line);
+}
+
+TEST(VmFastPaths, IntIndexedStoresBehaveTheSameInTheNativeTier) {
+  std::string src = kIntIndexStores;
+  // i, j and bad walk through and past the bounds: both tiers trap alike.
+  src.replace(src.find("a[i] := Bump"), 0, "i := (i + 1) MOD 6; j := (j + 1) MOD 5; bad := (bad + 1) MOD 7;\n");
+  same_in_both_tiers(src, 14);
+}
+
 TEST(VmFastPaths, IntIndexedReadsBehaveTheSameInTheNativeTier) {
   std::string src = kIntIndex;
   // bad walks 0..9: scans trap at 0 and 9 in both tiers alike.
