@@ -101,12 +101,13 @@ std::string op_name(st::Op op) { return st::op_info(op).name; }
 bool is_cond_jump(st::Op op) {
   std::string n = op_name(op);
   return n == "JMPF" || n == "JMPT" || n.rfind("JLT_", 0) == 0 || n.rfind("JGE_", 0) == 0 || n.rfind("JEQ_", 0) == 0 ||
-         n.rfind("JNE_", 0) == 0;
+         n.rfind("JNE_", 0) == 0 || n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0;
 }
 st::Op negated_jump(st::Op op) {
   std::string n = op_name(op);
   static const std::pair<const char*, const char*> swaps[] = {{"JMPF", "JMPT"}, {"JMPT", "JMPF"}, {"JLT_", "JGE_"},
-                                                             {"JGE_", "JLT_"}, {"JEQ_", "JNE_"}, {"JNE_", "JEQ_"}};
+                                                             {"JGE_", "JLT_"}, {"JEQ_", "JNE_"}, {"JNE_", "JEQ_"},
+                                                             {"JNLT_", "JLT_"}, {"JNGE_", "JGE_"}};
   for (auto [from, to] : swaps)
     if (n.rfind(from, 0) == 0) return ops_by_name().at(to + n.substr(std::strlen(from)));
   return op;

@@ -2,6 +2,8 @@
 // instances, methods and properties (frames on the method stack, static or dynamic
 // dispatch). Names that are none of these go to the standard functions (builtins.cpp).
 #include <algorithm>
+#include <map>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -192,11 +194,192 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
 
 // ------------------------------------------------------------------ functions
 
+namespace {
+// The names an expression mentions (reads, or passes on to a call that may write them);
+// false for a form this does not look into.
+bool mentions(const Expr* e, std::set<std::string>* out) {
+  if (!e) return true;
+  switch (e->kind) {
+    case ExprKind::Literal:
+    case ExprKind::EnumLiteral:
+    case ExprKind::DirectAddr:
+    case ExprKind::This:
+    case ExprKind::Super: return true;
+    case ExprKind::Name: out->insert(canon(static_cast<const NameExpr*>(e)->name.text)); return true;
+    case ExprKind::Member: return mentions(static_cast<const MemberExpr*>(e)->base.get(), out);
+    case ExprKind::BitAccess: return mentions(static_cast<const BitAccessExpr*>(e)->base.get(), out);
+    case ExprKind::Deref: return mentions(static_cast<const DerefExpr*>(e)->base.get(), out);
+    case ExprKind::Index: {
+      const auto* ix = static_cast<const IndexExpr*>(e);
+      for (const auto& i : ix->indices)
+        if (!mentions(i.get(), out)) return false;
+      return mentions(ix->base.get(), out);
+    }
+    case ExprKind::Call: {
+      const auto* c = static_cast<const CallExpr*>(e);
+      for (const auto& a : c->args) {
+        if (a.name) out->insert(canon(a.name->text));
+        if (!mentions(a.value.get(), out)) return false;
+      }
+      return mentions(c->callee.get(), out);
+    }
+    case ExprKind::Unary: return mentions(static_cast<const UnaryExpr*>(e)->operand.get(), out);
+    case ExprKind::Binary: {
+      // Iterative over the left spine: long operator chains are common.
+      const Expr* cur = e;
+      while (cur->kind == ExprKind::Binary) {
+        const auto* b = static_cast<const BinaryExpr*>(cur);
+        if (!mentions(b->rhs.get(), out)) return false;
+        cur = b->lhs.get();
+      }
+      return mentions(cur, out);
+    }
+    default: return false;
+  }
+}
+
+// The same for statements; false also where a path may leave the body early (RETURN).
+bool mentions(const StmtList& list, std::set<std::string>* out);
+bool mentions(const Stmt& s, std::set<std::string>* out) {
+  switch (s.kind) {
+    case StmtKind::Assign: {
+      const auto& a = static_cast<const AssignStmt&>(s);
+      return mentions(a.lhs.get(), out) && mentions(a.rhs.get(), out);
+    }
+    case StmtKind::Call: return mentions(static_cast<const CallStmt&>(s).call.get(), out);
+    case StmtKind::If: {
+      const auto& i = static_cast<const IfStmt&>(s);
+      for (const auto& arm : i.arms)
+        if (!mentions(arm.cond.get(), out) || !mentions(arm.body, out)) return false;
+      return !i.else_body || mentions(*i.else_body, out);
+    }
+    case StmtKind::Case: {
+      const auto& c = static_cast<const CaseStmt&>(s);
+      if (!mentions(c.selector.get(), out)) return false;
+      for (const auto& arm : c.arms) {
+        for (const auto& l : arm.labels)
+          if (!mentions(l.lo.get(), out) || !mentions(l.hi.get(), out)) return false;
+        if (!mentions(arm.body, out)) return false;
+      }
+      return !c.else_body || mentions(*c.else_body, out);
+    }
+    case StmtKind::For: {
+      const auto& f = static_cast<const ForStmt&>(s);
+      return mentions(f.var.get(), out) && mentions(f.from.get(), out) && mentions(f.to.get(), out) &&
+             mentions(f.by.get(), out) && mentions(f.body, out);
+    }
+    case StmtKind::While: {
+      const auto& w = static_cast<const WhileStmt&>(s);
+      return mentions(w.cond.get(), out) && mentions(w.body, out);
+    }
+    case StmtKind::Repeat: {
+      const auto& r = static_cast<const RepeatStmt&>(s);
+      return mentions(r.until.get(), out) && mentions(r.body, out);
+    }
+    case StmtKind::Exit:
+    case StmtKind::Continue:
+    case StmtKind::Empty: return true;
+    default: return false;  // RETURN, test-file statements
+  }
+}
+bool mentions(const StmtList& list, std::set<std::string>* out) {
+  for (const auto& s : list)
+    if (!mentions(*s, out)) return false;
+  return true;
+}
+}  // namespace
+
+// The frame ranges of a FUNCTION whose initial values no call needs: its VAR/VAR_TEMP
+// scalars and its result that the body assigns, at the top level and with a plain `:=`,
+// before any statement mentions them (so every path writes them before reading them).
+// The walk stops at the first statement it cannot follow (a RETURN, anything unknown).
+// Outputs are left out: a mocked FUNCTION returns without running its body.
+const std::vector<std::pair<uint32_t, uint32_t>>& Compiler::written_first(PouInfo* f) {
+  auto found = written_first_.find(f);
+  if (found != written_first_.end()) return found->second;
+  auto& ranges = written_first_[f];
+  const Pou* decl = decl_of(f);
+  if (!decl || f->kind != PouKind::Function) return ranges;
+  std::map<std::string, std::pair<uint32_t, uint32_t>> candidates;
+  for (const auto& v : f->vars)
+    if (v->where == Where::Frame && (v->section == VarSection::Var || v->section == VarSection::Temp) && v->type &&
+        v->type->is_elementary() && v->type->kind != TypeKind::Ref && v->type->kind != TypeKind::Interface && !v->constant)
+      candidates[canon(v->name)] = {v->offset, v->type->size};
+  if (f->result && f->result->is_elementary() && f->result->kind != TypeKind::Ref && f->result->kind != TypeKind::Interface &&
+      f->result->kind != TypeKind::Void)
+    candidates[canon(f->name)] = {f->result_offset, f->result->size};
+  std::set<std::string> seen;  // mentioned so far
+  for (const auto& st : decl->body) {
+    if (st->kind == StmtKind::Assign) {
+      const auto& a = static_cast<const AssignStmt&>(*st);
+      if (!a.is_ref_assign && !a.set_reset && a.lhs->kind == ExprKind::Name) {
+        std::string key = canon(static_cast<const NameExpr&>(*a.lhs).name.text);
+        if (!mentions(a.rhs.get(), &seen)) break;
+        auto c = candidates.find(key);
+        if (c != candidates.end() && !seen.count(key)) ranges.push_back(c->second);
+        seen.insert(key);
+        continue;
+      }
+    }
+    if (!mentions(*st, &seen)) break;
+  }
+  return ranges;
+}
+
+// Copies the parts of the frame template a call needs: not the inputs it stores, not
+// what the body writes before reading (written_first); the constants always.
+void Compiler::init_function_frame(PouInfo* f, Slot frame, const std::vector<const Symbol*>& stored) {
+  if (f->tmpl_to <= f->tmpl_from) return;
+  // Per byte: 2 copy, 1 either way (header, written first), 0 never (the call stored it:
+  // the arguments are in the frame already).
+  std::vector<uint8_t> need(f->tmpl_to - f->tmpl_from, 2);
+  auto mark_bytes = [&](uint32_t off, uint32_t size, uint8_t v) {
+    for (uint32_t k = off; k < off + size; ++k)
+      if (k >= f->tmpl_from && k < f->tmpl_to) need[k - f->tmpl_from] = std::min(need[k - f->tmpl_from], v);
+  };
+  mark_bytes(0, 8, 1);  // the header: a FUNCTION's is never read
+  for (auto [off, size] : written_first(f)) mark_bytes(off, size, 1);
+  for (const Symbol* s : stored) mark_bytes(s->offset, s->where == Where::InOut ? 4 : s->type->size, 0);
+  // Needed runs, joined across short either-way gaps when that saves an instruction.
+  std::vector<std::pair<uint32_t, uint32_t>> runs;  // [from, to) relative to tmpl_from
+  for (uint32_t k = 0; k < need.size();) {
+    if (need[k] != 2) {
+      ++k;
+      continue;
+    }
+    uint32_t e = k;
+    while (e < need.size() && need[e] == 2) ++e;
+    bool gap_free = !runs.empty() && std::all_of(need.begin() + runs.back().second, need.begin() + k, [](uint8_t v) { return v == 1; });
+    if (gap_free && k - runs.back().second <= 8) {
+      uint32_t merged = e - runs.back().first;
+      if (merged > 8 || merged == 4 || merged == 8) {
+        runs.back().second = e;
+        k = e;
+        continue;
+      }
+    }
+    runs.emplace_back(k, e);
+    k = e;
+  }
+  for (auto [from, to] : runs) {
+    uint32_t n = to - from;
+    Slot dst = frame.plus(f->tmpl_from + from);
+    uint32_t src_addr = f->template_addr + from;
+    switch (n) {
+      case 1: emit(Op::LDG1, {dst, src_addr}); break;
+      case 2: emit(Op::LDG2, {dst, src_addr}); break;
+      case 4: emit(Op::LDG4, {dst, src_addr}); break;
+      case 8: emit(Op::LDG8, {dst, src_addr}); break;
+      default: emit(Op::INITBLK, {dst, src_addr, n}); break;
+    }
+  }
+}
+
 Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
   ensure_compiled(f, c.loc);
   if (!f->compiled) return bad();
   Slot frame = temp(f->frame_size, 8);
-  if (f->tmpl_to > f->tmpl_from) emit(Op::INITBLK, {frame, f->template_addr, f->tmpl_to - f->tmpl_from});
+  std::vector<const Symbol*> stored;  // parameters this call writes into the frame
   std::vector<Symbol*> params = f->inputs;
   params.insert(params.end(), f->inouts.begin(), f->inouts.end());
   size_t pos = 0;
@@ -244,14 +427,17 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
         continue;
       }
       store(frame_place(frame.plus(p->offset), elem(TypeKind::UDInt)), addr_of(src, a.value->loc));
+      stored.push_back(p);
       continue;
     }
     if (is_reference(p->type)) {  // a REFERENCE TO input is bound to the argument
       bind_reference(frame_place(frame.plus(p->offset), p->type), *a.value, a.value->loc);
+      stored.push_back(p);
       continue;
     }
     Val v = expr_for(*a.value, p->type);
     assign(frame_place(frame.plus(p->offset), p->type), v, a.value->loc);
+    stored.push_back(p);  // whole: a STRING's bytes past its end are never read
   }
   // A non-formal call lists every input in order (IEC 61131-3 6.6.1.4.2); only a formal
   // call may leave inputs at their initial values.
@@ -264,6 +450,7 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
     for (size_t i = 0; i < params.size(); ++i)
       if (!given[i] && params[i]->where == Where::InOut)
         diags_.error("ST224", c.loc, "VAR_IN_OUT '" + params[i]->name + "' of " + f->name + " must be passed");
+  init_function_frame(f, frame, stored);
   mark(c.loc);
   emit(Op::CALL, {frame, Arg::entry(f)});
   for (const auto& o : outs) {

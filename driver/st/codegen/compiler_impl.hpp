@@ -100,6 +100,9 @@ struct Place {
   uint32_t count = 0; // FrameIdx
   uint32_t stride = 0;  // FrameIdx: element size (0: the value's own size, an array of scalars)
   uint32_t field = 0;   // FrameIdx: offset of the scalar inside the element
+  uint32_t idx_cvt = UINT32_MAX;  // FrameIdx: where this place emitted the conversion of its index to DINT
+  bool has_idx16 = false;  // FrameIdx: idx not made yet; the index is the INT variable idx16 (stores: STXH)
+  Slot idx16;
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -316,6 +319,9 @@ class Compiler {
   Place index_place(Place base, const IndexExpr& e);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);
+  Val load_once(const Place& p);
+  Slot frame_idx(const Place& p);  // FrameIdx: the DINT index slot (made here when deferred)
+  bool defer_index_cvt_ = false;  // the next index_place may leave an INT variable index as it is  // load of a place used only here (may fold its index conversion)
   void store(const Place& p, Slot src);
   void assign(const Place& dst, const Val& v, SourceLoc loc);
   Slot addr_of(const Place& p, SourceLoc loc);
@@ -325,6 +331,10 @@ class Compiler {
   Val call(const CallExpr& c, bool as_statement);
   bool may_call(const Expr& e) const;
   Val call_function(PouInfo* f, const CallExpr& c);
+  // The frame set-up of a FUNCTION call: the template's bytes this call needs (calls.cpp).
+  void init_function_frame(PouInfo* f, Slot frame, const std::vector<const Symbol*>& stored);
+  const std::vector<std::pair<uint32_t, uint32_t>>& written_first(PouInfo* f);
+  std::map<const PouInfo*, std::vector<std::pair<uint32_t, uint32_t>>> written_first_;
   Val call_fb(const Place& inst, PouInfo* fb, const CallExpr& c, PouInfo* body_of = nullptr);
   Val call_method(const CallExpr& c, PouInfo* m, const Place* inst, Slot this_ptr, bool virt);
   Val query_interface(const CallExpr& c, bool pointer);  // __QUERYINTERFACE, __QUERYPOINTER

@@ -484,10 +484,10 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
             return property_get(Place{}, g, itf.slot, e.loc);
           }
         }
-        return load(implicit_deref(member_place(base, m.member, e.loc), e.loc));
+        return load_once(implicit_deref(member_place(base, m.member, e.loc), e.loc));
       }
+      case ExprKind::Index: return load_once(place(e, false));
       case ExprKind::DirectAddr:
-      case ExprKind::Index:
       case ExprKind::Deref:
       case ExprKind::BitAccess: return load(place(e, false));
       case ExprKind::Call: {
@@ -797,7 +797,14 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     return bad();
   }
   if (t->kind == TypeKind::Bool) t = elem(TypeKind::Byte);
-  Slot a = operand(l, t), b = operand(r, t);
+  // Division by a constant (below) reads the divisor from its operands: no pool slot for it
+  // (a FUNCTION copies its pool into its frame on every call).
+  const bool by_const = (e.op == BinaryOp::Div || e.op == BinaryOp::Mod) && r.is_const && r.c.k == ConstV::K::Int &&
+                        (t->storage() == Storage::I16 || t->storage() == Storage::I32) && r.c.i != 0 && r.c.i != 1 &&
+                        r.c.i != -1 && r.c.i >= INT32_MIN + 1 && r.c.i <= INT32_MAX;
+  Slot a = operand(l, t), b;
+  if (by_const) (void)coerce(r.type ? r : Val{nullptr, true, true, r.c, {}}, t, e.loc, nullptr);  // its diagnostics
+  else b = operand(r, t);
   if (is_cmp(e.op)) {
     static const Op kCmp[] = {Op::LT_I8, Op::GT_I8, Op::LE_I8, Op::GE_I8, Op::EQ_I8, Op::NE_I8};
     return emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], t, a, b, elem(TypeKind::Bool));
@@ -820,9 +827,7 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   }
   if (!t->is_numeric() && !t->is_bitstring()) return op_error();
   // Division by a constant: multiply by a precomputed reciprocal instead of dividing.
-  if ((e.op == BinaryOp::Div || e.op == BinaryOp::Mod) && r.is_const && r.c.k == ConstV::K::Int &&
-      (t->storage() == Storage::I16 || t->storage() == Storage::I32) && r.c.i != 0 && r.c.i != 1 && r.c.i != -1 &&
-      r.c.i >= INT32_MIN + 1 && r.c.i <= INT32_MAX) {
+  if (by_const) {
     uint64_t k = static_cast<uint64_t>(r.c.i < 0 ? -r.c.i : r.c.i);
     uint64_t m = (uint64_t(1) << 63) / k + 1;
     bool i16 = t->storage() == Storage::I16;

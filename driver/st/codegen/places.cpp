@@ -1,6 +1,7 @@
 // Places (lvalues): name lookup, variables, members, array elements, dereferences,
 // THIS; loading from and storing to them, assignment and ADR.
 #include <algorithm>
+#include <optional>
 
 #include "compiler_impl.hpp"
 
@@ -362,6 +363,10 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
 Place Compiler::index_place(Place base, const IndexExpr& e) {
   Place bad_place;
   bad_place.ok = false;
+  // Set by an assignment whose right-hand side runs no call: an INT variable index cannot
+  // change before the store, which then reads it directly (STXH) instead of a DINT copy.
+  const bool defer = defer_index_cvt_ && e.indices.size() == 1;
+  defer_index_cvt_ = false;
   const Type* t = base.type;
   if (t->kind != TypeKind::Array) {
     diags_.error("ST208", e.loc, "'[ ]' needs an array, not " + t->name);
@@ -381,6 +386,8 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
   }
   uint64_t const_disp = 0;
   std::vector<std::pair<size_t, Slot>> dyn;
+  uint32_t idx_cvt = UINT32_MAX;
+  std::optional<Slot> raw16;
   for (size_t i = 0; i < e.indices.size(); ++i) {
     Val v = expr(*e.indices[i], elem(TypeKind::DInt));
     if (!v.ok) return bad_place;
@@ -415,8 +422,19 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
         emit(int_op(Op::CHK_I8, v.type->storage()), {v.slot, los, his, 1u});
       }
     }
+    if (defer && v.slot.kind == SK::Var && v.type->storage() == Storage::I16) {
+      raw16 = v.slot;
+      dyn.emplace_back(i, Slot{});
+      continue;
+    }
+    size_t before = b_->code.size();
     dyn.emplace_back(i, convert(v.slot, v.type, elem(TypeKind::DInt)));
+    if (b_->code.size() != before) idx_cvt = b_->last_instr;
   }
+  bool fast = dyn.size() == 1 && base.k == Place::K::Frame && t->dims.size() == 1 &&
+              ((t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) ||
+               t->elem->kind == TypeKind::Struct || t->elem->kind == TypeKind::Pou);
+  if (raw16 && !fast) dyn[0].second = convert(*raw16, elem(TypeKind::Int), elem(TypeKind::DInt));
   if (dyn.empty()) {
     Place p = base;
     p.type = t->elem;
@@ -435,9 +453,14 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     p.off = base.off;
     p.sk = base.sk;
     p.idx = dyn[0].second;
+    if (raw16) {
+      p.has_idx16 = true;
+      p.idx16 = *raw16;
+    }
     p.lo = static_cast<int32_t>(t->dims[0].lo);
     p.count = static_cast<uint32_t>(t->dims[0].hi - t->dims[0].lo + 1);
     p.stride = t->elem->is_elementary() ? 0 : esize;
+    p.idx_cvt = idx_cvt;
     p.readonly = base.readonly;
     return p;
   }
@@ -491,7 +514,7 @@ Slot Compiler::addr_of(const Place& p, SourceLoc loc) {
       Slot a = temp(4, 4);
       emit(Op::ADDR, {a, Slot{p.off, p.sk}});
       Slot t = temp(4, 4);
-      emit(Op::ELEM, {t, a, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride ? p.stride : p.type->size});
+      emit(Op::ELEM, {t, a, frame_idx(p), static_cast<uint32_t>(p.lo), p.count, p.stride ? p.stride : p.type->size});
       if (p.field == 0) return t;
       Slot f = temp(4, 4);
       emit(Op::ADDRI, {f, t, p.field});
@@ -504,6 +527,50 @@ Slot Compiler::addr_of(const Place& p, SourceLoc loc) {
 }
 
 // ------------------------------------------------------------------ load/store
+
+// A read of an element of a frame array through an INT index, right after the index's
+// conversion to DINT: the element is read with the INT index itself (LDXH, LDXSH) and the
+// conversion dropped. Only for a place read once, here: another use of the place would
+// read the dropped DINT copy.
+Val Compiler::load_once(const Place& p) {
+  auto& code = b_->code;
+  uint32_t at = b_->last_instr;
+  uint32_t size = p.ok && p.type ? p.type->size : 0;
+  if (!p.ok || p.k != Place::K::FrameIdx || p.has_idx16 || !p.type->is_elementary() || !(size == 1 || size == 2 || size == 4 || size == 8) ||
+      at >= code.size() || p.idx_cvt != at || code[at] != static_cast<uint32_t>(Op::CVT_I16_I32) || b_->last_def_pos != at ||
+      b_->last_label_pos > at || b_->last_def.kind != SK::Temp || p.idx.kind != SK::Temp || b_->last_def.off != p.idx.off ||
+      (!b_->lines.empty() && b_->lines.back().first > at))
+    return load(p);
+  Arg x(code[at + 2]);
+  for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
+    if (it->first == at + 2) x = Arg(Slot{code[at + 2], it->second});
+    if (it->first >= at) it = b_->slot_fix.erase(it);
+    else ++it;
+  }
+  code.resize(at);
+  b_->last_def_pos = UINT32_MAX;
+  for (auto it = b_->cvt_cache.begin(); it != b_->cvt_cache.end();) {
+    if (it->second.kind == p.idx.kind && it->second.off == p.idx.off) it = b_->cvt_cache.erase(it);
+    else ++it;
+  }
+  Slot t = temp_for(p.type);
+  if (p.stride) {
+    Op op = size == 1 ? Op::LDXSH1 : size == 2 ? Op::LDXSH2 : size == 4 ? Op::LDXSH4 : Op::LDXSH8;
+    emit(op, {t, Slot{p.off, p.sk}, x, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+  } else {
+    Op op = size == 1 ? Op::LDXH1 : size == 2 ? Op::LDXH2 : size == 4 ? Op::LDXH4 : Op::LDXH8;
+    emit(op, {t, Slot{p.off, p.sk}, x, static_cast<uint32_t>(p.lo), p.count});
+  }
+  def(t);
+  Val v;
+  v.type = p.type;
+  v.slot = t;
+  return v;
+}
+
+Slot Compiler::frame_idx(const Place& p) {
+  return p.has_idx16 ? convert(p.idx16, elem(TypeKind::Int), elem(TypeKind::DInt)) : p.idx;
+}
 
 Val Compiler::load(const Place& p) {
   Val v;
@@ -553,13 +620,14 @@ Val Compiler::load(const Place& p) {
       return v;
     }
     case Place::K::FrameIdx: {
+      Slot idx = frame_idx(p);
       Slot t = temp_for(p.type);
       if (p.stride) {
         Op op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
-        emit(op, {t, Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
       } else {
         Op op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
-        emit(op, {t, Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count});
+        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count});
       }
       def(t);
       v.slot = t;
@@ -627,6 +695,16 @@ void Compiler::store(const Place& p, Slot src) {
         default: emit(Op::STIN, {p.ptr, p.off, src, size}); return;
       }
     case Place::K::FrameIdx: {
+      if (p.has_idx16 && p.stride) {
+        Op op = size == 1 ? Op::STXSH1 : size == 2 ? Op::STXSH2 : size == 4 ? Op::STXSH4 : Op::STXSH8;
+        emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        return;
+      }
+      if (p.has_idx16) {
+        Op op = size == 1 ? Op::STXH1 : size == 2 ? Op::STXH2 : size == 4 ? Op::STXH4 : Op::STXH8;
+        emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, src});
+        return;
+      }
       if (p.stride) {
         Op op = size == 1 ? Op::STXS1 : size == 2 ? Op::STXS2 : size == 4 ? Op::STXS4 : Op::STXS8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});

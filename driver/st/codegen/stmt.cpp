@@ -81,9 +81,19 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
       };
       for (const auto& m : kMap) {
         if (in_block != m.cmp) continue;
-        // Floating-point compares are not inverted (NaN makes a < b and a >= b both false).
+        // Floating-point compares are not inverted (NaN makes a < b and a >= b both false):
+        // the jump on a failed comparison is its own instruction (JNLT, JNGE); = and <>
+        // invert exactly (NaN = x is FALSE, NaN <> x is TRUE).
         bool is_float = type_idx >= 8;
-        if (is_float && !when_true) break;
+        Op j = when_true ? m.jtrue : m.jfalse;
+        bool swap = when_true ? m.jtrue_swap : m.jfalse_swap;
+        Op fj = Op::NOP;
+        if (is_float && !when_true && m.cmp != Op::EQ_I8 && m.cmp != Op::NE_I8) {
+          bool f64 = type_idx == 9;
+          bool lt = m.cmp == Op::LT_I8 || m.cmp == Op::GT_I8;  // a < b, or b < a
+          fj = lt ? (f64 ? Op::JNLT_F64 : Op::JNLT_F32) : (f64 ? Op::JNGE_F64 : Op::JNGE_F32);
+          swap = m.cmp == Op::GT_I8 || m.cmp == Op::LE_I8;
+        }
         Arg a(code[at + 2]), b2(code[at + 3]);
         for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
           if (it->first == at + 2) a = Arg(Slot{code[at + 2], it->second});
@@ -92,9 +102,8 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
           else ++it;
         }
         code.resize(at);
-        Op j = when_true ? m.jtrue : m.jfalse;
-        bool swap = when_true ? m.jtrue_swap : m.jfalse_swap;
-        emit(static_cast<Op>(static_cast<uint32_t>(j) + type_idx * stride), {Arg::target(target.id), swap ? b2 : a, swap ? a : b2});
+        Op op_j = fj != Op::NOP ? fj : static_cast<Op>(static_cast<uint32_t>(j) + type_idx * stride);
+        emit(op_j, {Arg::target(target.id), swap ? b2 : a, swap ? a : b2});
         b_->last_def_pos = UINT32_MAX;
         return;
       }
@@ -243,7 +252,9 @@ void Compiler::assign_stmt(const AssignStmt& s) {
         }
       }
       if (!bs || (bs->type && bs->type->kind == TypeKind::Pou && !bs->type->field(m.member.text)) || !bs) {
+        defer_index_cvt_ = !may_call(*s.rhs) && !may_call(*base_e);  // arr[i].f := e: see index_place
         Place base = place(*base_e, true);
+        defer_index_cvt_ = false;
         if (!base.ok) return;
         if (base.type->kind == TypeKind::Pou && base.type->pou && !base.type->field(m.member.text)) {
           if (PouInfo* st = base.type->pou->find_method(setter)) {
@@ -285,7 +296,9 @@ void Compiler::assign_stmt(const AssignStmt& s) {
       }
     }
   }
+  defer_index_cvt_ = !s.is_ref_assign && !may_call(*s.rhs) && !may_call(*s.lhs);  // arr[i] := e: see index_place
   Place dst = s.is_ref_assign ? place_ref(*s.lhs, true) : place(*s.lhs, true);
+  defer_index_cvt_ = false;
   if (!dst.ok) {
     expr(*s.rhs);  // still check the right-hand side
     return;

@@ -81,6 +81,7 @@ void jump_targets(const uint32_t* w, std::vector<uint32_t>* out) {
   std::string_view n = op_info(op).name;
   if (n.size() > 4 && (n.substr(0, 4) == "JLT_" || n.substr(0, 4) == "JGE_" || n.substr(0, 4) == "JEQ_" || n.substr(0, 4) == "JNE_"))
     out->push_back(w[1]);
+  if (n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0) out->push_back(w[1]);
   if (n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) out->push_back(w[4]);
 }
 
@@ -549,6 +550,53 @@ class Translator {
         // |K| >= 2: C's truncating division by the literal is the instruction's result
         // (no overflow), and the C++ compiler picks the best multiply-shift sequence.
         s = W(t, 1, fmt::format("({})((int32_t){} {} (int32_t){})", t, R(t, 2), mod ? "%" : "/", S(5)));
+        return true;
+      }
+      case Op::JNLT_F32:
+      case Op::JNGE_F32:
+      case Op::JNLT_F64:
+      case Op::JNGE_F64: {
+        const char* t = op == Op::JNLT_F32 || op == Op::JNGE_F32 ? "float" : "double";
+        const char* rel = op == Op::JNLT_F32 || op == Op::JNLT_F64 ? "<" : ">=";
+        s = fmt::format("if (!({} {} {})) {}", R(t, 2), rel, R(t, 3), jump(1));
+        return true;
+      }
+      case Op::STXH1:
+      case Op::STXH2:
+      case Op::STXH4:
+      case Op::STXH8:
+      case Op::STXSH1:
+      case Op::STXSH2:
+      case Op::STXSH4:
+      case Op::STXSH8: {
+        // STX/STXS with an INT index.
+        std::string_view nm = op_info(op).name;
+        bool structs = nm[3] == 'S';
+        int n = nm.back() - '0';
+        const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
+        s = fmt::format("int64_t i = (int64_t){0} - (int64_t){1}; if (i < 0 || i >= (int64_t){2}) TRAP(2, {3}u, {0}, 0, 0); ",
+                        R("int16_t", 2), S(3), K(4), pc);
+        std::string addr = structs ? fmt::format("base + {} + i * {} + {}", K(1), K(5), K(6)) : fmt::format("base + {} + i * {}", K(1), n);
+        s += fmt::format("st<{}>({}, {});", t, addr, R(t, structs ? 7 : 5));
+        return true;
+      }
+      case Op::LDXH1:
+      case Op::LDXH2:
+      case Op::LDXH4:
+      case Op::LDXH8:
+      case Op::LDXSH1:
+      case Op::LDXSH2:
+      case Op::LDXSH4:
+      case Op::LDXSH8: {
+        // LDX/LDXS with an INT index.
+        std::string_view nm = op_info(op).name;
+        bool structs = nm[3] == 'S';
+        int n = nm.back() - '0';
+        const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
+        s = fmt::format("int64_t i = (int64_t){0} - (int64_t){1}; if (i < 0 || i >= (int64_t){2}) TRAP(2, {3}u, {0}, 0, 0); ",
+                        R("int16_t", 3), S(4), K(5), pc);
+        std::string addr = structs ? fmt::format("base + {} + i * {} + {}", K(2), K(6), K(7)) : fmt::format("base + {} + i * {}", K(2), n);
+        s += W(t, 1, fmt::format("ld<{}>({})", t, addr));
         return true;
       }
       default: break;

@@ -604,6 +604,62 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   LDXS_IMPL(8, uint64_t)
 #undef LDXS_IMPL
 
+// The same with an INT index (LDXH, LDXSH): no DINT copy of a loop counter per access.
+#define LDXH_IMPL(N, T)                                                                        \
+  L_LDXH##N: {                                                                                 \
+    int64_t i = static_cast<int64_t>(R(int16_t, 3)) - static_cast<int32_t>(pc[4]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int16_t, 3), static_cast<int32_t>(pc[4]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
+    W(T, 1, ld<T>(base + pc[2] + i * N));                                                      \
+    NEXT(5);                                                                                   \
+  }                                                                                            \
+  L_LDXSH##N: {                                                                                \
+    int64_t i = static_cast<int64_t>(R(int16_t, 3)) - static_cast<int32_t>(pc[4]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int16_t, 3), static_cast<int32_t>(pc[4]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
+    W(T, 1, ld<T>(base + pc[2] + i * pc[6] + pc[7]));                                          \
+    NEXT(7);                                                                                   \
+  }
+#define STXH_IMPL(N, T)                                                                        \
+  L_STXH##N: {                                                                                 \
+    int64_t i = static_cast<int64_t>(R(int16_t, 2)) - static_cast<int32_t>(pc[3]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int16_t, 2), static_cast<int32_t>(pc[3]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
+    st<T>(base + pc[1] + i * N, R(T, 5));                                                      \
+    NEXT(5);                                                                                   \
+  }                                                                                            \
+  L_STXSH##N: {                                                                                \
+    int64_t i = static_cast<int64_t>(R(int16_t, 2)) - static_cast<int32_t>(pc[3]);             \
+    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
+      return fail(TrapKind::IndexOutOfRange, pc,                                               \
+                  fmt::format("index {} outside {}..{}", R(int16_t, 2), static_cast<int32_t>(pc[3]), \
+                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
+    st<T>(base + pc[1] + i * pc[5] + pc[6], R(T, 7));                                          \
+    NEXT(7);                                                                                   \
+  }
+  STXH_IMPL(1, uint8_t)
+  STXH_IMPL(2, uint16_t)
+  STXH_IMPL(4, uint32_t)
+  STXH_IMPL(8, uint64_t)
+#undef STXH_IMPL
+  LDXH_IMPL(1, uint8_t)
+  LDXH_IMPL(2, uint16_t)
+  LDXH_IMPL(4, uint32_t)
+  LDXH_IMPL(8, uint64_t)
+#undef LDXH_IMPL
+
+// Float compare-and-jump, taken when the comparison fails (NaN included).
+L_JNLT_F32: if (!(R(float, 2) < R(float, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
+L_JNGE_F32: if (!(R(float, 2) >= R(float, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
+L_JNLT_F64: if (!(R(double, 2) < R(double, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
+L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
+
 #define DIVK_IMPL(NAME, T, IS_MOD)                                                      \
   L_##NAME: {                                                                           \
     uint64_t m = static_cast<uint64_t>(pc[3]) | (static_cast<uint64_t>(pc[4]) << 32);   \
