@@ -227,7 +227,7 @@ class Translator {
     if (us == std::string_view::npos) return false;
     std::string_view fam = n.substr(0, us), tn = n.substr(us + 1);
     static const char* const kSafe[] = {"ADD", "SUB", "MUL", "NEG", "EQ", "NE", "LT", "LE", "GT", "GE", "JLT", "JGE",
-                                        "JEQ", "JNE", "MIN", "MAX", "ABS", "CVT", "AND", "OR", "XOR", "NOT", "SHL",
+                                        "JEQ", "JNE", "JNLT", "JNGE", "MIN", "MAX", "ABS", "CVT", "AND", "OR", "XOR", "NOT", "SHL",
                                         "SHR", "ROL", "ROR", "ROUND", "TRUNC", "MODZ"};
     for (const char* f : kSafe)
       if (fam == f) return true;
@@ -764,7 +764,7 @@ class Translator {
     if (us != std::string_view::npos) {
       std::string_view fam = n.substr(0, us);
       static const char* const kPure[] = {"ADD", "SUB", "MUL", "DIV", "NEG", "EQ", "NE", "LT", "LE", "GT", "GE", "JLT",
-                                          "JGE", "JEQ", "JNE", "MIN", "MAX", "ABS", "CVT", "MOD", "MODZ", "AND", "OR",
+                                          "JGE", "JEQ", "JNE", "JNLT", "JNGE", "MIN", "MAX", "ABS", "CVT", "MOD", "MODZ", "AND", "OR",
                                           "XOR", "NOT", "SHL", "SHR", "ROL", "ROR", "CHK", "LOOPUP", "LOOPDN", "ROUND",
                                           "TRUNC"};
       for (const char* f : kPure)
