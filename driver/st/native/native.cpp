@@ -561,56 +561,19 @@ class Translator {
         s = fmt::format("if (!({} {} {})) {}", R(t, 2), rel, R(t, 3), jump(1));
         return true;
       }
-      case Op::STXH1:
-      case Op::STXH2:
-      case Op::STXH4:
-      case Op::STXH8:
-      case Op::STXSH1:
-      case Op::STXSH2:
-      case Op::STXSH4:
-      case Op::STXSH8: {
-        // STX/STXS with an INT index.
-        std::string_view nm = op_info(op).name;
-        bool structs = nm[3] == 'S';
-        int n = nm.back() - '0';
-        const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
-        s = fmt::format("int64_t i = (int64_t){0} - (int64_t){1}; if (i < 0 || i >= (int64_t){2}) TRAP(2, {3}u, {0}, 0, 0); ",
-                        R("int16_t", 2), S(3), K(4), pc);
-        std::string addr = structs ? fmt::format("base + {} + i * {} + {}", K(1), K(5), K(6)) : fmt::format("base + {} + i * {}", K(1), n);
-        s += fmt::format("st<{}>({}, {});", t, addr, R(t, structs ? 7 : 5));
-        return true;
-      }
-      case Op::LDXH1:
-      case Op::LDXH2:
-      case Op::LDXH4:
-      case Op::LDXH8:
-      case Op::LDXSH1:
-      case Op::LDXSH2:
-      case Op::LDXSH4:
-      case Op::LDXSH8: {
-        // LDX/LDXS with an INT index.
-        std::string_view nm = op_info(op).name;
-        bool structs = nm[3] == 'S';
-        int n = nm.back() - '0';
-        const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
-        s = fmt::format("int64_t i = (int64_t){0} - (int64_t){1}; if (i < 0 || i >= (int64_t){2}) TRAP(2, {3}u, {0}, 0, 0); ",
-                        R("int16_t", 3), S(4), K(5), pc);
-        std::string addr = structs ? fmt::format("base + {} + i * {} + {}", K(2), K(6), K(7)) : fmt::format("base + {} + i * {}", K(2), n);
-        s += W(t, 1, fmt::format("ld<{}>({})", t, addr));
-        return true;
-      }
       default: break;
     }
     std::string_view name = op_info(op).name;
-    // Element access into frame arrays (bounds-checked).
+    // Element access into frame arrays (bounds-checked); an H variant takes an INT index.
     if (name.rfind("LDX", 0) == 0 || name.rfind("STX", 0) == 0) {
       bool structs = name[3] == 'S';
+      const char* index = name.find('H') != std::string_view::npos ? "int16_t" : "int32_t";
       int n = name.back() - '0';
       const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
       bool load = name[0] == 'L';
       int idx = load ? 3 : 2, lo = idx + 1, cnt = idx + 2;
       s = fmt::format("int64_t i = (int64_t){0} - (int64_t){1}; if (i < 0 || i >= (int64_t){2}) TRAP(2, {3}u, {0}, 0, 0); ",
-                      R("int32_t", idx), S(lo), K(cnt), pc);
+                      R(index, idx), S(lo), K(cnt), pc);
       std::string addr = structs ? fmt::format("base + {} + i * {} + {}", K(load ? 2 : 1), K(load ? 6 : 5), K(load ? 7 : 6))
                                  : fmt::format("base + {} + i * {}", K(load ? 2 : 1), n);
       if (load) s += W(t, 1, fmt::format("ld<{}>({})", t, addr));

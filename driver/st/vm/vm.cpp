@@ -554,105 +554,30 @@ L_ROUND_F64: W(double, 1, round_even(R(double, 2))); NEXT(2);
 L_TRUNC_F32: W(float, 1, std::trunc(R(float, 2))); NEXT(2);
 L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
 
-#define LDX_IMPL(N, T)                                                                         \
-  L_LDX##N: {                                                                                  \
-    int64_t i = static_cast<int64_t>(R(int32_t, 3)) - static_cast<int32_t>(pc[4]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int32_t, 3), static_cast<int32_t>(pc[4]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
-    W(T, 1, ld<T>(base + pc[2] + i * N));                                                      \
-    NEXT(5);                                                                                   \
-  }                                                                                            \
-  L_STX##N: {                                                                                  \
-    int64_t i = static_cast<int64_t>(R(int32_t, 2)) - static_cast<int32_t>(pc[3]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int32_t, 2), static_cast<int32_t>(pc[3]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
-    st<T>(base + pc[1] + i * N, R(T, 5));                                                      \
-    NEXT(5);                                                                                   \
-  }
-  LDX_IMPL(1, uint8_t)
-  LDX_IMPL(2, uint16_t)
-  LDX_IMPL(4, uint32_t)
-  LDX_IMPL(8, uint64_t)
-#undef LDX_IMPL
-
-#define LDXS_IMPL(N, T)                                                                        \
-  L_LDXS##N: {                                                                                 \
-    int64_t i = static_cast<int64_t>(R(int32_t, 3)) - static_cast<int32_t>(pc[4]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int32_t, 3), static_cast<int32_t>(pc[4]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
-    W(T, 1, ld<T>(base + pc[2] + i * pc[6] + pc[7]));                                          \
-    NEXT(7);                                                                                   \
-  }                                                                                            \
-  L_STXS##N: {                                                                                 \
-    int64_t i = static_cast<int64_t>(R(int32_t, 2)) - static_cast<int32_t>(pc[3]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int32_t, 2), static_cast<int32_t>(pc[3]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
-    st<T>(base + pc[1] + i * pc[5] + pc[6], R(T, 7));                                          \
-    NEXT(7);                                                                                   \
-  }
-  LDXS_IMPL(1, uint8_t)
-  LDXS_IMPL(2, uint16_t)
-  LDXS_IMPL(4, uint32_t)
-  LDXS_IMPL(8, uint64_t)
-#undef LDXS_IMPL
-
-// The same with an INT index (LDXH, LDXSH): no DINT copy of a loop counter per access.
-#define LDXH_IMPL(N, T)                                                                        \
-  L_LDXH##N: {                                                                                 \
-    int64_t i = static_cast<int64_t>(R(int16_t, 3)) - static_cast<int32_t>(pc[4]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int16_t, 3), static_cast<int32_t>(pc[4]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
-    W(T, 1, ld<T>(base + pc[2] + i * N));                                                      \
-    NEXT(5);                                                                                   \
-  }                                                                                            \
-  L_LDXSH##N: {                                                                                \
-    int64_t i = static_cast<int64_t>(R(int16_t, 3)) - static_cast<int32_t>(pc[4]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[5]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int16_t, 3), static_cast<int32_t>(pc[4]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1)); \
-    W(T, 1, ld<T>(base + pc[2] + i * pc[6] + pc[7]));                                          \
-    NEXT(7);                                                                                   \
-  }
-#define STXH_IMPL(N, T)                                                                        \
-  L_STXH##N: {                                                                                 \
-    int64_t i = static_cast<int64_t>(R(int16_t, 2)) - static_cast<int32_t>(pc[3]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int16_t, 2), static_cast<int32_t>(pc[3]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
-    st<T>(base + pc[1] + i * N, R(T, 5));                                                      \
-    NEXT(5);                                                                                   \
-  }                                                                                            \
-  L_STXSH##N: {                                                                                \
-    int64_t i = static_cast<int64_t>(R(int16_t, 2)) - static_cast<int32_t>(pc[3]);             \
-    if (i < 0 || i >= static_cast<int64_t>(pc[4]))                                             \
-      return fail(TrapKind::IndexOutOfRange, pc,                                               \
-                  fmt::format("index {} outside {}..{}", R(int16_t, 2), static_cast<int32_t>(pc[3]), \
-                              static_cast<int64_t>(static_cast<int32_t>(pc[3])) + pc[4] - 1)); \
-    st<T>(base + pc[1] + i * pc[5] + pc[6], R(T, 7));                                          \
-    NEXT(7);                                                                                   \
-  }
-  STXH_IMPL(1, uint8_t)
-  STXH_IMPL(2, uint16_t)
-  STXH_IMPL(4, uint32_t)
-  STXH_IMPL(8, uint64_t)
-#undef STXH_IMPL
-  LDXH_IMPL(1, uint8_t)
-  LDXH_IMPL(2, uint16_t)
-  LDXH_IMPL(4, uint32_t)
-  LDXH_IMPL(8, uint64_t)
-#undef LDXH_IMPL
+// Element access into frame arrays, bounds-checked: LDX/STX (elementary elements),
+// LDXS/STXS (a field of a structure element), each with a DINT index or, as the H
+// variants, an INT index (no DINT copy of a loop counter per access).
+#define ELEM_INDEX(IT, k)                                                                      \
+  int64_t i = static_cast<int64_t>(R(IT, k)) - static_cast<int32_t>(pc[k + 1]);                \
+  if (i < 0 || i >= static_cast<int64_t>(pc[k + 2]))                                           \
+    return fail(TrapKind::IndexOutOfRange, pc,                                                 \
+                fmt::format("index {} outside {}..{}", R(IT, k), static_cast<int32_t>(pc[k + 1]), \
+                            static_cast<int64_t>(static_cast<int32_t>(pc[k + 1])) + pc[k + 2] - 1));
+#define ELEM_IMPL(H, IT, N, T)                                                                 \
+  L_LDX##H##N: { ELEM_INDEX(IT, 3) W(T, 1, ld<T>(base + pc[2] + i * N)); NEXT(5); }            \
+  L_STX##H##N: { ELEM_INDEX(IT, 2) st<T>(base + pc[1] + i * N, R(T, 5)); NEXT(5); }            \
+  L_LDXS##H##N: { ELEM_INDEX(IT, 3) W(T, 1, ld<T>(base + pc[2] + i * pc[6] + pc[7])); NEXT(7); } \
+  L_STXS##H##N: { ELEM_INDEX(IT, 2) st<T>(base + pc[1] + i * pc[5] + pc[6], R(T, 7)); NEXT(7); }
+  ELEM_IMPL(, int32_t, 1, uint8_t)
+  ELEM_IMPL(, int32_t, 2, uint16_t)
+  ELEM_IMPL(, int32_t, 4, uint32_t)
+  ELEM_IMPL(, int32_t, 8, uint64_t)
+  ELEM_IMPL(H, int16_t, 1, uint8_t)
+  ELEM_IMPL(H, int16_t, 2, uint16_t)
+  ELEM_IMPL(H, int16_t, 4, uint32_t)
+  ELEM_IMPL(H, int16_t, 8, uint64_t)
+#undef ELEM_IMPL
+#undef ELEM_INDEX
 
 // Float compare-and-jump, taken when the comparison fails (NaN included).
 L_JNLT_F32: if (!(R(float, 2) < R(float, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
