@@ -9,6 +9,7 @@
 #include <string>
 
 #include "engine.hpp"
+#include "vm_run.hpp"
 
 // The replacements below forward to malloc/free on purpose; GCC cannot see that they pair up.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
@@ -47,33 +48,7 @@ void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); 
 namespace plcfi::st {
 namespace {
 
-// A compiled single-file application and a machine running its first program.
-struct VmRun {
-  std::unique_ptr<Build> b;
-  std::unique_ptr<Machine> m;
-
-  explicit VmRun(const std::string& src, CompileOptions opt = {}) {
-    b = build_sources({{"vm.st", src}}, opt);
-    if (!b->ok()) {
-      ADD_FAILURE() << b->diags.render_all();
-      return;
-    }
-    m = std::make_unique<Machine>(*b->app);
-  }
-  bool ok() const { return m != nullptr; }
-  bool scan() {
-    const auto& p = b->app->programs.at(0);
-    return m->call(p.pou->entry, p.addr);
-  }
-  VarHandle h(const std::string& path) const {
-    std::string err;
-    auto r = resolve(*b->app, path, &err);
-    if (!r) ADD_FAILURE() << err;
-    return r.value_or(VarHandle{});
-  }
-  int64_t get(const std::string& path) const { return read_int(*m, h(path)); }
-  void set(const std::string& path, int64_t v) { write_int(*m, h(path), v); }
-};
+using vmtest::VmRun;
 
 // ------------------------------------------------------------------ traps
 

@@ -12,41 +12,14 @@
 
 #include "engine.hpp"
 #include "native/native.hpp"
+#include "vm_run.hpp"
 
 namespace plcfi::st {
 namespace {
 
-struct Prog {
-  std::unique_ptr<Build> b;
-  std::unique_ptr<Machine> m;
-  explicit Prog(const std::string& src) {
-    b = build_sources({{"fast.st", src}}, CompileOptions{});
-    if (!b->ok()) {
-      ADD_FAILURE() << b->diags.render_all();
-      return;
-    }
-    m = std::make_unique<Machine>(*b->app);
-  }
-  bool ok() const { return m != nullptr; }
-  bool scan() {
-    const auto& p = b->app->programs.at(0);
-    return m->call(p.pou->entry, p.addr);
-  }
-  VarHandle h(const std::string& path) const {
-    std::string err;
-    auto r = resolve(*b->app, path, &err);
-    if (!r) ADD_FAILURE() << err;
-    return r.value_or(VarHandle{});
-  }
-  int64_t get(const std::string& path) const { return read_int(*m, h(path)); }
-  double real(const std::string& path) const { return read_real(*m, h(path)); }
-  void set(const std::string& path, int64_t v) { write_int(*m, h(path), v); }
-  std::string disasm() const { return disassemble(*b->app, b.get()); }
-  uint32_t taken_count() const {
-    uint32_t n = 0;
-    for (uint64_t w : m->taken()) n += static_cast<uint32_t>(__builtin_popcountll(w));
-    return n;
-  }
+// The VM fixture, compiling the source as fast.st.
+struct Prog : vmtest::VmRun {
+  explicit Prog(const std::string& src) : VmRun(src, {}, "fast.st") {}
 };
 
 // Both tiers, scan by scan: same result, trap, memory, coverage.
