@@ -223,15 +223,38 @@ class Translator {
       default: break;
     }
     std::string_view n = op_info(op).name;
-    size_t us = n.find('_');
-    if (us == std::string_view::npos) return false;
-    std::string_view fam = n.substr(0, us), tn = n.substr(us + 1);
-    static const char* const kSafe[] = {"ADD", "SUB", "MUL", "NEG", "EQ", "NE", "LT", "LE", "GT", "GE", "JLT", "JGE",
-                                        "JEQ", "JNE", "JNLT", "JNGE", "MIN", "MAX", "ABS", "CVT", "AND", "OR", "XOR", "NOT", "SHL",
-                                        "SHR", "ROL", "ROR", "ROUND", "TRUNC", "MODZ"};
-    for (const char* f : kSafe)
-      if (fam == f) return true;
-    return fam == "DIV" && (tn == "F32" || tn == "F64");  // only integer division traps
+    const TypedFamily* f = typed_family(n);
+    if (!f) return false;
+    if (f->traps == TypedFamily::kIntegers) return n.substr(n.find('_') + 1)[0] == 'F';  // DIV on REAL/LREAL
+    return f->traps == TypedFamily::kNever;
+  }
+
+  // The typed instruction families (NAME_TYPE) that work on frame registers only: they
+  // write nothing but their destination (through W). Some can trap.
+  struct TypedFamily {
+    const char* name;
+    enum { kNever, kIntegers, kAlways } traps;
+  };
+  static const TypedFamily* typed_family(std::string_view op_name) {
+    static const TypedFamily kFamilies[] = {
+        {"ADD", TypedFamily::kNever},    {"SUB", TypedFamily::kNever},    {"MUL", TypedFamily::kNever},
+        {"DIV", TypedFamily::kIntegers}, {"NEG", TypedFamily::kNever},    {"EQ", TypedFamily::kNever},
+        {"NE", TypedFamily::kNever},     {"LT", TypedFamily::kNever},     {"LE", TypedFamily::kNever},
+        {"GT", TypedFamily::kNever},     {"GE", TypedFamily::kNever},     {"JLT", TypedFamily::kNever},
+        {"JGE", TypedFamily::kNever},    {"JEQ", TypedFamily::kNever},    {"JNE", TypedFamily::kNever},
+        {"JNLT", TypedFamily::kNever},   {"JNGE", TypedFamily::kNever},   {"MIN", TypedFamily::kNever},
+        {"MAX", TypedFamily::kNever},    {"ABS", TypedFamily::kNever},    {"CVT", TypedFamily::kNever},
+        {"MOD", TypedFamily::kAlways},   {"MODZ", TypedFamily::kNever},   {"AND", TypedFamily::kNever},
+        {"OR", TypedFamily::kNever},     {"XOR", TypedFamily::kNever},    {"NOT", TypedFamily::kNever},
+        {"SHL", TypedFamily::kNever},    {"SHR", TypedFamily::kNever},    {"ROL", TypedFamily::kNever},
+        {"ROR", TypedFamily::kNever},    {"CHK", TypedFamily::kAlways},   {"LOOPUP", TypedFamily::kAlways},
+        {"LOOPDN", TypedFamily::kAlways}, {"ROUND", TypedFamily::kNever}, {"TRUNC", TypedFamily::kNever},
+    };
+    size_t us = op_name.find('_');
+    if (us == std::string_view::npos) return nullptr;
+    for (const TypedFamily& f : kFamilies)
+      if (op_name.substr(0, us) == f.name) return &f;
+    return nullptr;
   }
 
   void summarize() {
@@ -723,16 +746,7 @@ class Translator {
     if (n.rfind("STXS", 0) == 0) return range(w[1], uint64_t{w[4]} * w[5]);
     if (n.rfind("STX", 0) == 0) return range(w[1], uint64_t{w[4]} * static_cast<uint64_t>(n.back() - '0'));
     if (n.rfind("LDX", 0) == 0) return {};
-    size_t us = n.find('_');
-    if (us != std::string_view::npos) {
-      std::string_view fam = n.substr(0, us);
-      static const char* const kPure[] = {"ADD", "SUB", "MUL", "DIV", "NEG", "EQ", "NE", "LT", "LE", "GT", "GE", "JLT",
-                                          "JGE", "JEQ", "JNE", "JNLT", "JNGE", "MIN", "MAX", "ABS", "CVT", "MOD", "MODZ", "AND", "OR",
-                                          "XOR", "NOT", "SHL", "SHR", "ROL", "ROR", "CHK", "LOOPUP", "LOOPDN", "ROUND",
-                                          "TRUNC"};
-      for (const char* f : kPure)
-        if (fam == f) return {};
-    }
+    if (typed_family(n)) return {};
     return {true};  // calls, pointers, absolute stores, host functions, anything new
   }
 
