@@ -806,7 +806,11 @@ class Translator {
       if (falls && i + 1 < pcs.size()) succ[i].push_back(i + 1);
       std::vector<uint32_t> t;
       jump_targets(&code_[pcs[i]], &t);
-      for (uint32_t x : t) succ[i].push_back(index_of_.at(x));
+      for (uint32_t x : t) {
+        auto at = index_of_.find(x);
+        if (at == index_of_.end()) return false;  // not an instruction start: left to the interpreter
+        succ[i].push_back(at->second);
+      }
     }
     auto solve = [&] {
       valid_in_.assign(pcs.size(), std::vector<uint64_t>(words, ~uint64_t{0}));
