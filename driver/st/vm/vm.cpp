@@ -17,6 +17,18 @@ namespace plcfi::st {
 using namespace ops;  // NOLINT: the instruction semantics
 
 namespace {
+// Superinstructions (see run()): which operand of the second instruction takes the first's
+// result, as its word index.
+constexpr uint32_t FUSE_B = 2, FUSE_C = 3;
+template <class T> inline T fadd(T a, T b) { return a + b; }
+template <class T> inline T fmul(T a, T b) { return a * b; }
+template <class T> inline T band(T a, T b) { return static_cast<T>(a & b); }
+template <class T> inline bool jge(T a, T b) { return a >= b; }
+inline bool jnlt(float a, float b) { return !(a < b); }
+inline bool overlap(uint32_t a, uint32_t na, uint32_t b, uint32_t nb) {
+  return static_cast<uint64_t>(a) < static_cast<uint64_t>(b) + nb && static_cast<uint64_t>(b) < static_cast<uint64_t>(a) + na;
+}
+
 constexpr OpInfo kOps[] = {
 #define OP(name, nargs, rtl) {#name, nargs, rtl},
 #include "opcodes.def"
@@ -105,7 +117,10 @@ void Machine::set_count_hits(bool on) {
 
 bool Machine::fail(TrapKind k, const uint32_t* pc, std::string msg) {
   trap_.kind = k;
-  trap_.pc = static_cast<uint32_t>(pc - app_->code.data());
+  // pc points into the threaded copy (the interpreter) or into the application's code (the
+  // native tier's assertions); both have the same layout.
+  const uint32_t* code = !exec_.empty() && pc >= exec_.data() && pc < exec_.data() + exec_.size() ? exec_.data() : app_->code.data();
+  trap_.pc = static_cast<uint32_t>(pc - code);
   trap_.loc = app_->loc_of(trap_.pc);
   trap_.message = std::move(msg);
   return false;
@@ -118,7 +133,7 @@ bool Machine::call(uint32_t entry, uint32_t base_addr) {
   if (native_)
     if (native_abi::Fn fn = native_->find(entry)) return call_native(reinterpret_cast<const void*>(fn), mem_.data() + base_addr);
   int64_t budget = static_cast<int64_t>(budget_limit_);
-  return run(app_->code.data() + entry, mem_.data() + base_addr, app_->mstack_addr, &budget);
+  return run(entry, mem_.data() + base_addr, app_->mstack_addr, &budget);
 }
 
 // ----------------------------------------------------------------- native tier
@@ -167,7 +182,7 @@ struct NativeBridge {
     Machine& vm = m(c);
     if (native_abi::Fn fn = vm.native_->find(entry)) return fn(c, base);
     int64_t budget = c->budget;
-    bool ok = vm.run(vm.app_->code.data() + entry, base, c->mtop, &budget);
+    bool ok = vm.run(entry, base, c->mtop, &budget);
     c->budget = budget;
     return ok ? native_abi::kOk : native_abi::kTrap;
   }
@@ -205,10 +220,117 @@ bool Machine::call_native(const void* fn, uint8_t* base) {
 // one indirect jump per instruction, predicted per opcode site.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpedantic"
-bool Machine::run(const uint32_t* pc, uint8_t* base, uint32_t mtop, int64_t* budget_io) {
+// Superinstructions: two adjacent instructions in one handler (interpreter only).
+//
+// thread_code() rewrites the opcode word of the first instruction of a pair listed here to
+// the pair's handler; the second keeps its own word, so a jump to it runs it alone, and
+// both keep their operands and positions: a pc, a trap's location and the branch taken are
+// the same as with the two instructions run one by one. A pair P(H, T) runs H and goes on
+// straight to T's handler (no dispatch). A pair F(H, T, B|C) is one where T reads the
+// slot H has just written as its operand b or c: H's value is stored as usual and also
+// handed to T in a register, which spares T a reload of what was just stored (the
+// store-to-load latency is most of the cost of a chain of instructions).
+// The pairs are the most frequent ones in the MATIEC kernels and the stamping program
+// (counted per dispatch): argument moves and calls, loop bodies, arithmetic chains.
+#define PLCFI_FUSED(P, F, P3, FF3, SUM)                                                     \
+  SUM(B) SUM(C)                                                                           \
+  FF3(MUL_I32, ADD_I32, B, MODK_I32, B) FF3(MUL_I32, DIVK_I32, B, JGE_I32, B)             \
+  FF3(MUL_I32, DIVK_I32, B, JGE_I32, C) FF3(CVT_I16_I32, MUL_I32, C, ADD_I32, C)          \
+  FF3(CVT_I16_I32, MUL_I32, B, ADD_I32, C) FF3(SUB_F32, MUL_F32, C, ADD_F32, C)           \
+  FF3(MUL_F32, ADD_F32, B, JNLT_F32, C) FF3(MUL_F32, ADD_F32, B, JNLT_F32, B)             \
+  P3(MOV4, MOV4, CALL) P3(MOV1, MOV8, RET) P3(MOV1, MOV8, CALL)                           \
+  F(MUL_I32, ADD_I32, B) F(MUL_I32, ADD_I32, C) F(ADD_I32, MODK_I32, B)                   \
+  F(MODK_I32, SUB_I32, B) F(MODK_I32, ADD_I32, B) F(MODK_I32, ADD_I32, C)                 \
+  F(MUL_I32, DIVK_I32, B) F(DIVK_I32, JGE_I32, B) F(DIVK_I32, JGE_I32, C)                 \
+  F(LDXH4, ADD_I32, B) F(LDXH4, ADD_I32, C) F(LDXH4, JGE_I32, B) F(LDXH4, JGE_I32, C)     \
+  F(CVT_I16_I32, MUL_I32, B) F(CVT_I16_I32, MUL_I32, C)                                   \
+  F(SUB_F32, MUL_F32, B) F(SUB_F32, MUL_F32, C) F(MUL_F32, ADD_F32, B)                    \
+  F(MUL_F32, ADD_F32, C) F(ADD_F32, JNLT_F32, B) F(ADD_F32, JNLT_F32, C)                  \
+  F(EQ_I16, BAND, B) F(EQ_I16, BAND, C) F(BNOT, BAND, B) F(BNOT, BAND, C)                 \
+  P(MOV1, MOV1) P(MOV1, MOV4) P(MOV1, MOV8) P(MOV1, CALL) P(MOV1, RET)                    \
+  P(MOV4, MOV1) P(MOV4, MOV4) P(MOV4, CALL) P(MOV4, RET)                                  \
+  P(MOV8, CALL) P(MOV8, RET) P(MOV2, CALL)                                                \
+  P(COV, MOV1) P(COV, MOV4) P(COV, ADD_I32)                                               \
+  P(JMPF, COV) P(JGE_I32, COV) P(JNLT_F32, COV)                                           \
+  P(ADD_I32, LOOPUP_I16) P(ADD_I32, LOOPUP_I32) P(ADD_F32, MOV4) P(SUB_I32, MOV4)         \
+  P(LDXH4, LDXH4) P(EQ_I16, MOV8) P(BAND, MOV1)
+
+void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules) {
+  const std::vector<uint32_t>& code = app_->code;
+  exec_ = code;
+  fused_.clear();
+  const auto n = static_cast<uint32_t>(code.size());
+  auto length = [&](uint32_t pc) -> uint32_t {
+    uint32_t op = code[pc];
+    uint32_t len = op < static_cast<uint32_t>(Op::Count_) ? op_length(&code[pc]) : 0;
+    return len <= n - pc ? len : 0;
+  };
+  uint32_t pc = 0;
+  while (pc < n) {
+    uint32_t len = length(pc);
+    if (len == 0) {
+      // Not an instruction the compiler emits: from here on every word stops the VM.
+      for (; pc < n; ++pc) exec_[pc] = static_cast<uint32_t>(invalid);
+      break;
+    }
+    exec_[pc] = static_cast<uint32_t>(offsets[code[pc]]);
+    uint32_t next = pc + len;
+    // The first rule that fits (triples come first). Every instruction may head one: the
+    // second of a pair keeps a word of its own for jumps to it.
+    uint32_t second_len = next < n ? length(next) : 0;
+    uint32_t third = next + second_len;
+    for (size_t r = 0; second_len != 0 && r < n_rules; ++r) {
+      const FusedRule& f = rules[r];
+      if (code[pc] != static_cast<uint32_t>(f.head) || code[next] != static_cast<uint32_t>(f.tail)) continue;
+      if (f.operand != 0 && code[next + f.operand] != code[pc + 1]) continue;
+      if (f.third != Op::Count_ && (third >= n || length(third) == 0 || code[third] != static_cast<uint32_t>(f.third))) continue;
+      if (f.operand2 != 0 && code[third + f.operand2] != code[next + 1]) continue;
+      exec_[pc] = static_cast<uint32_t>(f.offset);
+      fused_.emplace_back(pc, &f);
+      break;
+    }
+    pc = next;
+  }
+}
+
+std::vector<std::pair<uint32_t, std::string>> Machine::superinstructions() const {
+  std::vector<std::pair<uint32_t, std::string>> out;
+  for (auto [pc, f] : fused_) {
+    std::string name = std::string(op_info(f->head).name) + "+" + op_info(f->tail).name;
+    if (f->third != Op::Count_) name += std::string("+") + op_info(f->third).name;
+    out.emplace_back(pc, std::move(name));
+  }
+  return out;
+}
+
+bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_io) {
+  // Handler addresses as offsets from the first handler, one per opcode.
+#define LABEL_OFFSET(l) static_cast<int32_t>(reinterpret_cast<intptr_t>(&&l) - reinterpret_cast<intptr_t>(&&L_NOP))
+  static const int32_t kOffsets[] = {
+#define OP(name, nargs, rtl) LABEL_OFFSET(L_##name),
+#include "opcodes.def"
+#undef OP
+  };
+  static const FusedRule kFused[] = {
+#define RULE_P(H, T) {Op::H, Op::T, Op::Count_, 0, 0, LABEL_OFFSET(L_P_##H##_##T)},
+#define RULE_F(H, T, K) {Op::H, Op::T, Op::Count_, FUSE_##K, 0, LABEL_OFFSET(L_F_##H##_##T##_##K)},
+#define RULE_P3(H, T, U) {Op::H, Op::T, Op::U, 0, 0, LABEL_OFFSET(L_P3_##H##_##T##_##U)},
+#define RULE_FF3(H, T, K, U, K2) {Op::H, Op::T, Op::U, FUSE_##K, FUSE_##K2, LABEL_OFFSET(L_FF3_##H##_##T##_##K##_##U##_##K2)},
+#define RULE_SUM(K) {Op::LDXH4, Op::ADD_I32, Op::LOOPUP_I16, FUSE_##K, 0, LABEL_OFFSET(L_SUM_##K)},
+      PLCFI_FUSED(RULE_P, RULE_F, RULE_P3, RULE_FF3, RULE_SUM)
+#undef RULE_SUM
+#undef RULE_FF3
+#undef RULE_P
+#undef RULE_F
+#undef RULE_P3
+  };
+  if (exec_.size() != app_->code.size()) [[unlikely]]
+    thread_code(kOffsets, LABEL_OFFSET(L_INVALID), kFused, std::size(kFused));
+  const char* const handlers = static_cast<const char*>(&&L_NOP);
   uint8_t* const mem = mem_.data();
   const uint64_t msize = mem_.size();
-  const uint32_t* const code = app_->code.data();
+  const uint32_t* const code = exec_.data();
+  const uint32_t* pc = code + entry;
   const uint32_t* const vtable = app_->vtable.data();
   const uint32_t n_types = app_->n_types;
   uint64_t* const taken = taken_.data();
@@ -216,13 +338,7 @@ bool Machine::run(const uint32_t* pc, uint8_t* base, uint32_t mtop, int64_t* bud
   const uint32_t mend = app_->mstack_addr + app_->mstack_size;
   int64_t budget = *budget_io;
 
-  static const void* const kLabels[] = {
-#define OP(name, nargs, rtl) &&L_##name,
-#include "opcodes.def"
-#undef OP
-  };
-
-#define DISPATCH() goto* kLabels[*pc]
+#define DISPATCH() goto* static_cast<const void*>(handlers + static_cast<int32_t>(*pc))
 #define NEXT(n)  \
   do {           \
     pc += 1 + n; \
@@ -316,13 +432,13 @@ L_CALLV: {
   if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
   PTR(inst, 2, 0, 8);
   uint32_t type = ld<uint16_t>(mem + inst);
-  uint32_t entry = type < n_types ? vtable[pc[3] * n_types + type] : 0;
-  if (entry == 0) return fail(TrapKind::NotImplemented, pc, "the instance's type does not implement this method");
+  uint32_t target = type < n_types ? vtable[pc[3] * n_types + type] : 0;
+  if (target == 0) return fail(TrapKind::NotImplemented, pc, "the instance's type does not implement this method");
   uint8_t* frame = mem + ld<uint32_t>(base + pc[1]);
   st<uint32_t>(frame + 8, static_cast<uint32_t>(inst));
   stack_[sp++] = {pc + 4, base, mtop};
   base = frame;
-  pc = code + entry;
+  pc = code + target;
   DISPATCH();
 }
 L_JTAB: {
@@ -347,6 +463,8 @@ L_FNMOCK:
   NEXT(3);
 L_TRAP:
   return fail(static_cast<TrapKind>(pc[1]), pc, trap_name(static_cast<TrapKind>(pc[1])));
+L_INVALID:
+  return fail(TrapKind::BadAddress, pc, "not an instruction");
 
 L_MOV1: W(uint8_t, 1, R(uint8_t, 2)); NEXT(2);
 L_MOV2: W(uint16_t, 1, R(uint16_t, 2)); NEXT(2);
@@ -577,7 +695,6 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   ELEM_IMPL(H, int16_t, 4, uint32_t)
   ELEM_IMPL(H, int16_t, 8, uint64_t)
 #undef ELEM_IMPL
-#undef ELEM_INDEX
 
 // Float compare-and-jump, taken when the comparison fails (NaN included).
 L_JNLT_F32: if (!(R(float, 2) < R(float, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
@@ -597,6 +714,141 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) { pc = code + pc[1]; DISPATCH()
   DIVK_IMPL(MODK_I32, int32_t, true)
 #undef DIVK_IMPL
 
+
+// The first instruction: its effect (defining v, the value it stored) and its length.
+#define HV_SIMPLE(T, e) T v = (e); W(T, 1, v);
+#define HV_MOV1 HV_SIMPLE(uint8_t, R(uint8_t, 2))
+#define HV_MOV2 HV_SIMPLE(uint16_t, R(uint16_t, 2))
+#define HV_MOV4 HV_SIMPLE(uint32_t, R(uint32_t, 2))
+#define HV_MOV8 HV_SIMPLE(uint64_t, R(uint64_t, 2))
+#define HV_ADD_I32 HV_SIMPLE(int32_t, wadd<int32_t>(R(int32_t, 2), R(int32_t, 3)))
+#define HV_SUB_I32 HV_SIMPLE(int32_t, wsub<int32_t>(R(int32_t, 2), R(int32_t, 3)))
+#define HV_MUL_I32 HV_SIMPLE(int32_t, wmul<int32_t>(R(int32_t, 2), R(int32_t, 3)))
+#define HV_ADD_F32 HV_SIMPLE(float, R(float, 2) + R(float, 3))
+#define HV_SUB_F32 HV_SIMPLE(float, R(float, 2) - R(float, 3))
+#define HV_MUL_F32 HV_SIMPLE(float, R(float, 2) * R(float, 3))
+#define HV_EQ_I16 HV_SIMPLE(uint8_t, R(int16_t, 2) == R(int16_t, 3))
+#define HV_BNOT HV_SIMPLE(uint8_t, static_cast<uint8_t>(R(uint8_t, 2) ^ 1u))
+#define HV_BAND HV_SIMPLE(uint8_t, static_cast<uint8_t>(R(uint8_t, 2) & R(uint8_t, 3)))
+#define HV_CVT_I16_I32 HV_SIMPLE(int32_t, R(int16_t, 2))
+#define HV_DIVK(T, IS_MOD) \
+  HV_SIMPLE(T, (divk<T, IS_MOD>(R(T, 2), static_cast<uint64_t>(pc[3]) | (static_cast<uint64_t>(pc[4]) << 32), static_cast<int32_t>(pc[5]))))
+#define HV_MODK_I32 HV_DIVK(int32_t, true)
+#define HV_DIVK_I32 HV_DIVK(int32_t, false)
+#define HV_LDXH4 ELEM_INDEX(int16_t, 3) HV_SIMPLE(int32_t, ld<int32_t>(base + pc[2] + i * 4))
+#define HV_COV taken[pc[1] >> 6] |= uint64_t(1) << (pc[1] & 63); [[maybe_unused]] int v = 0;
+#define HV_JUMP_IF(c) if (c) { pc = code + pc[1]; DISPATCH(); } [[maybe_unused]] int v = 0;
+#define HV_JMPF HV_JUMP_IF(!ld<uint8_t>(base + pc[2]))
+#define HV_JGE_I32 HV_JUMP_IF(R(int32_t, 2) >= R(int32_t, 3))
+#define HV_JNLT_F32 HV_JUMP_IF(!(R(float, 2) < R(float, 3)))
+#define HL_MOV1 2
+#define HL_MOV2 2
+#define HL_MOV4 2
+#define HL_MOV8 2
+#define HL_ADD_I32 3
+#define HL_SUB_I32 3
+#define HL_MUL_I32 3
+#define HL_ADD_F32 3
+#define HL_SUB_F32 3
+#define HL_MUL_F32 3
+#define HL_EQ_I16 3
+#define HL_BNOT 2
+#define HL_BAND 3
+#define HL_CVT_I16_I32 2
+#define HL_MODK_I32 5
+#define HL_DIVK_I32 5
+#define HL_LDXH4 5
+#define HL_COV 1
+#define HL_JMPF 2
+#define HL_JGE_I32 3
+#define HL_JNLT_F32 3
+// The second instruction with X (the value the first stored) as its operand b (_B) or c
+// (_C): TV_ ends the handler with END (NEXT, or THEN_ for a third), MV_ defines OUT as the
+// value it stored, for a third instruction to take in turn.
+#define OPND_B(T, X) (static_cast<T>(X)), R(T, 3)
+#define OPND_C(T, X) R(T, 2), (static_cast<T>(X))
+#define TV_ARITH(T, f, K, END, X) W(T, 1, f<T>(OPND_##K(T, X))); END(3);
+#define MV_ARITH(T, f, K, X, OUT) T OUT = f<T>(OPND_##K(T, X)); W(T, 1, OUT);
+#define TV_ADD_I32(K, END, X) TV_ARITH(int32_t, wadd, K, END, X)
+#define TV_SUB_I32(K, END, X) TV_ARITH(int32_t, wsub, K, END, X)
+#define TV_MUL_I32(K, END, X) TV_ARITH(int32_t, wmul, K, END, X)
+#define TV_MUL_F32(K, END, X) TV_ARITH(float, fmul, K, END, X)
+#define TV_ADD_F32(K, END, X) TV_ARITH(float, fadd, K, END, X)
+#define TV_BAND(K, END, X) TV_ARITH(uint8_t, band, K, END, X)
+#define MV_ADD_I32(K, X, OUT) MV_ARITH(int32_t, wadd, K, X, OUT)
+#define MV_MUL_I32(K, X, OUT) MV_ARITH(int32_t, wmul, K, X, OUT)
+#define MV_MUL_F32(K, X, OUT) MV_ARITH(float, fmul, K, X, OUT)
+#define MV_ADD_F32(K, X, OUT) MV_ARITH(float, fadd, K, X, OUT)
+#define TV_JGE_I32(K, END, X) if (jge<int32_t>(OPND_##K(int32_t, X))) { pc = code + pc[1]; DISPATCH(); } END(3);
+#define TV_JNLT_F32(K, END, X) if (jnlt(OPND_##K(float, X))) { pc = code + pc[1]; DISPATCH(); } END(3);
+#define DIVK_OF(T, IS_MOD, X) \
+  (divk<T, IS_MOD>(static_cast<T>(X), static_cast<uint64_t>(pc[3]) | (static_cast<uint64_t>(pc[4]) << 32), static_cast<int32_t>(pc[5])))
+#define TV_MODK_I32(K, END, X) W(int32_t, 1, DIVK_OF(int32_t, true, X)); END(5);
+#define TV_DIVK_I32(K, END, X) W(int32_t, 1, DIVK_OF(int32_t, false, X)); END(5);
+#define MV_DIVK_I32(K, X, OUT) int32_t OUT = DIVK_OF(int32_t, false, X); W(int32_t, 1, OUT);
+
+// Triples: a pair and the instruction after it, run by its own handler.
+#define FUSED_P(H, T) L_P_##H##_##T: { HV_##H (void)v; pc += 1 + HL_##H; goto L_##T; }
+#define FUSED_F(H, T, K) L_F_##H##_##T##_##K: { HV_##H pc += 1 + HL_##H; TV_##T(K, NEXT, v) }
+#define FUSED_P3(H, T, U) \
+  L_P3_##H##_##T##_##U: { { HV_##H (void)v; pc += 1 + HL_##H; } { HV_##T (void)v; pc += 1 + HL_##T; } goto L_##U; }
+#define FUSED_FF3(H, T, K, U, K2)                                               \
+  L_FF3_##H##_##T##_##K##_##U##_##K2: {                                         \
+    HV_##H pc += 1 + HL_##H;                                                    \
+    MV_##T(K, v, w) pc += 1 + HL_##T;                                           \
+    TV_##U(K2, NEXT, w)                                                         \
+  }
+#define THEN_LOOPUP_I16(n) pc += 1 + n; goto L_LOOPUP_I16
+// The loop `FOR i := .. DO s := s + a[i]; END_FOR` (LDXH4 t := a[i]; ADD_I32 s := s + t;
+// LOOPUP_I16 on i back to the LDXH4): the whole loop in one handler, i and s carried in
+// registers from one iteration to the next. Every iteration stores t, s and i as the three
+// instructions do, so memory is exact whenever the loop ends or traps; the array, the
+// step and the limit are read from memory each time. Only when the three store to
+// disjoint slots (otherwise, and when the loop jumps elsewhere, the three run as a triple).
+#define FUSED_SUM(K)                                                                               \
+  L_SUM_##K: {                                                                                     \
+    const uint32_t* const x = pc;                                                                  \
+    const uint32_t* const a = pc + 6;                                                              \
+    const uint32_t* const l = pc + 10;                                                             \
+    const uint32_t acc = a[FUSE_##K == FUSE_C ? 2 : 3];                                            \
+    if (l[4] != static_cast<uint32_t>(x - code) || l[1] != x[3] || acc != a[1] || overlap(x[1], 4, a[1], 4) || \
+        overlap(x[1], 4, l[1], 2) || overlap(a[1], 4, l[1], 2)) {                                  \
+      HV_LDXH4 pc += 6;                                                                            \
+      TV_ADD_I32(K, THEN_LOOPUP_I16, v)                                                            \
+    }                                                                                              \
+    int16_t i = ld<int16_t>(base + x[3]);                                                          \
+    int32_t s = ld<int32_t>(base + a[1]);                                                          \
+    for (;;) {                                                                                     \
+      int64_t e = static_cast<int64_t>(i) - static_cast<int32_t>(x[4]);                            \
+      if (e < 0 || e >= static_cast<int64_t>(x[5])) goto L_LDXH4; /* traps there, pc = x */       \
+      int32_t t = ld<int32_t>(base + x[2] + e * 4);                                                \
+      st<int32_t>(base + x[1], t);                                                                 \
+      s = wadd<int32_t>(s, t);                                                                     \
+      st<int32_t>(base + a[1], s);                                                                 \
+      int16_t next;                                                                                \
+      bool ovf = __builtin_add_overflow(i, ld<int16_t>(base + l[2]), &next);                       \
+      st<int16_t>(base + l[1], next);                                                              \
+      if (ovf || next > ld<int16_t>(base + l[3])) {                                                \
+        pc = l + 5;                                                                                \
+        DISPATCH();                                                                                \
+      }                                                                                            \
+      pc = l;                                                                                      \
+      BACKJUMP();                                                                                  \
+      pc = x;                                                                                      \
+      i = next;                                                                                    \
+    }                                                                                              \
+  }
+  PLCFI_FUSED(FUSED_P, FUSED_F, FUSED_P3, FUSED_FF3, FUSED_SUM)
+#undef FUSED_SUM
+#undef FUSED_FF3
+#undef FUSED_P
+#undef FUSED_F
+#undef FUSED_P3
+#undef THEN_LOOPUP_I16
+#undef ELEM_INDEX
+
+#undef LABEL_OFFSET
+#undef PLCFI_FUSED
 #undef DISPATCH
 #undef NEXT
 #undef R

@@ -100,6 +100,10 @@ class Machine {
   // Assertion bookkeeping for the test runner.
   const std::string& assert_message() const { return assert_message_; }
 
+  // The superinstructions the interpreter runs (see run()): (pc of the first instruction,
+  // the instructions it runs, as "MUL_I32+ADD_I32"). Empty until the first call.
+  std::vector<std::pair<uint32_t, std::string>> superinstructions() const;
+
   // The native tier (native/native.hpp): entries it has run natively, the rest in the
   // interpreter. nullptr: interpreter only. The code must outlive the machine's use of it.
   void set_native(const NativeCode* code) { native_ = code; }
@@ -112,11 +116,27 @@ class Machine {
   bool fail(TrapKind k, const uint32_t* pc, std::string msg);
   // Interprets from pc until the matching RET. mtop: the method stack top; budget: the
   // backward jumps left (read and, on a normal return, written back).
-  bool run(const uint32_t* pc, uint8_t* base, uint32_t mtop, int64_t* budget);
+  bool run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget);
+  // Builds exec_ from the application's code (see run()): each opcode word becomes its
+  // handler's offset, or a superinstruction's when the instruction and the next (and the
+  // one after, for a triple) fit one of `rules` (operand: 0, or the word of the second
+  // instruction that must name the slot the first writes: 2 = its operand b, 3 = c).
+  struct FusedRule {
+    Op head, tail, third;  // third: Op::Count_ for a pair
+    uint32_t operand, operand2;  // operand2: the same for the third and the second
+    int32_t offset;
+  };
+  void thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules);
   bool call_native(const void* fn, uint8_t* base);
   bool do_assert(const uint32_t* pc, uint8_t* base);
 
   const Application* app_;
+  // The code as the interpreter runs it (direct threading): the application's code with
+  // each opcode word replaced by its handler's offset from the first handler. Operands,
+  // positions and length are the application's, so a pc means the same in both. Built on
+  // the first call.
+  std::vector<uint32_t> exec_;
+  std::vector<std::pair<uint32_t, const FusedRule*>> fused_;  // the heads rewritten in exec_
   std::vector<uint8_t> mem_;
   std::vector<uint64_t> taken_, covered_;
   std::vector<uint64_t> hits_;  // index = branch id; sized by set_count_hits(true)
