@@ -260,6 +260,8 @@ void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRu
   exec_ = code;
   fused_.clear();
   const auto n = static_cast<uint32_t>(code.size());
+  std::vector<uint8_t> heads(static_cast<size_t>(Op::Count_), 0);  // ops that start some rule
+  for (size_t r = 0; r < n_rules; ++r) heads[static_cast<size_t>(rules[r].head)] = 1;
   auto length = [&](uint32_t pc) -> uint32_t {
     uint32_t op = code[pc];
     uint32_t len = op < static_cast<uint32_t>(Op::Count_) ? op_length(&code[pc]) : 0;
@@ -277,7 +279,7 @@ void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRu
     uint32_t next = pc + len;
     // The first rule that fits (triples come first). Every instruction may head one: the
     // second of a pair keeps a word of its own for jumps to it.
-    uint32_t second_len = next < n ? length(next) : 0;
+    uint32_t second_len = heads[code[pc]] && next < n ? length(next) : 0;
     uint32_t third = next + second_len;
     for (size_t r = 0; second_len != 0 && r < n_rules; ++r) {
       const FusedRule& f = rules[r];
