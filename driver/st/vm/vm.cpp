@@ -216,22 +216,28 @@ bool Machine::call_native(const void* fn, uint8_t* base) {
   return reinterpret_cast<native_abi::Fn>(const_cast<void*>(fn))(&c, base) != native_abi::kTrap;
 }
 
-// Dispatch uses computed goto (a GNU extension, as CPython's and Lua's fast paths do):
-// one indirect jump per instruction, predicted per opcode site.
+// Dispatch uses computed goto (a GNU extension, as CPython's and Lua's fast paths do) on
+// the threaded code: one indirect jump per instruction or superinstruction, predicted per
+// handler, to the handler whose offset the opcode word holds.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpedantic"
-// Superinstructions: two adjacent instructions in one handler (interpreter only).
+// Superinstructions: two or three adjacent instructions in one handler (interpreter only).
 //
-// thread_code() rewrites the opcode word of the first instruction of a pair listed here to
-// the pair's handler; the second keeps its own word, so a jump to it runs it alone, and
-// both keep their operands and positions: a pc, a trap's location and the branch taken are
-// the same as with the two instructions run one by one. A pair P(H, T) runs H and goes on
-// straight to T's handler (no dispatch). A pair F(H, T, B|C) is one where T reads the
-// slot H has just written as its operand b or c: H's value is stored as usual and also
-// handed to T in a register, which spares T a reload of what was just stored (the
-// store-to-load latency is most of the cost of a chain of instructions).
-// The pairs are the most frequent ones in the MATIEC kernels and the stamping program
-// (counted per dispatch): argument moves and calls, loop bodies, arithmetic chains.
+// thread_code() rewrites the opcode word of the first instruction of a sequence listed
+// here to the sequence's handler; the others keep their own words, so a jump to one of
+// them runs it alone, and all keep their operands and positions: a pc, a trap's location
+// and the branch taken are the same as with the instructions run one by one. Every store
+// is done as the plain instructions do it.
+//   P(H, T), P3(H, T, U)  run H (and T) and go on straight to the last one's handler,
+//                         without a dispatch;
+//   F(H, T, B|C)          T reads the slot H has just written, as its operand b or c: the
+//                         value is handed to T in a register, which spares T the reload
+//                         (store-to-load latency is most of the cost of a chain);
+//   FF3(H, T, B|C, U, B|C)  the same along a chain of three;
+//   SUM(B|C)              the loop `s := s + a[i]` as a whole (FUSED_SUM below).
+// The sequences are the most frequent ones in the MATIEC kernels and the stamping program
+// (counted per dispatch): argument moves and calls, loop bodies, arithmetic chains, REAL
+// compare-and-jump with its coverage bit.
 #define PLCFI_FUSED(P, F, P3, FF3, SUM)                                                     \
   SUM(B) SUM(C)                                                                           \
   FF3(MUL_I32, ADD_I32, B, MODK_I32, B) FF3(MUL_I32, DIVK_I32, B, JGE_I32, B)             \

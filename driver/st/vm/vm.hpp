@@ -132,9 +132,11 @@ class Machine {
 
   const Application* app_;
   // The code as the interpreter runs it (direct threading): the application's code with
-  // each opcode word replaced by its handler's offset from the first handler. Operands,
+  // each opcode word replaced by its handler's offset from the first handler (a
+  // superinstruction's at the first instruction of a sequence it runs). Operands,
   // positions and length are the application's, so a pc means the same in both. Built on
-  // the first call.
+  // the first call: the application's code must not change while the machine is used
+  // (mutation analysis patches it before it makes the machines that run the mutant).
   std::vector<uint32_t> exec_;
   std::vector<std::pair<uint32_t, const FusedRule*>> fused_;  // the heads rewritten in exec_
   std::vector<uint8_t> mem_;
