@@ -490,6 +490,9 @@ std::string format(const Machine& m, const VarHandle& h) {
     case TypeKind::Real: return fmt::format("{}", load_as<float>(p));
     case TypeKind::LReal: return fmt::format("{}", load_as<double>(p));
     case TypeKind::Time: case TypeKind::LTime: return duration(load_as<int64_t>(p));
+    case TypeKind::Date: return date_literal(load_as<int64_t>(p));
+    case TypeKind::TimeOfDay: return tod_literal(load_as<int64_t>(p));
+    case TypeKind::DateTime: return dt_literal(load_as<int64_t>(p));
     case TypeKind::String: case TypeKind::WString: {
       const char* s = reinterpret_cast<const char*>(p);
       return "'" + std::string(s, strnlen(s, t->str_len)) + "'";

@@ -137,6 +137,10 @@ class Gen {
   std::string place_text(const Place& p, const Scope& s, int depth);
   std::string expr(T t, const Scope& s, int depth);
   std::string call_text(const Callable& c, const Scope& s, int depth);
+  std::string date_literal();  // D#, TOD# and DT# with random fields
+  std::string tod_literal();
+  std::string dt_literal();
+  static std::string two(int v) { return (v < 10 ? "0" : "") + std::to_string(v); }
   std::string stmt(const Scope& s, int depth);
   std::string stmts(const Scope& s, int n, int depth, const std::string& sep = " ");
   std::string assign(const Place& p, const Scope& s, int depth);
@@ -154,6 +158,7 @@ class Gen {
   int loops_ = 0;
   std::vector<std::pair<std::string, std::vector<Place>>> refs_;  // Main's references and their targets
   T fio_type_ = T::Dint;                          // FIO's parameters and result
+  std::vector<std::string> fio_order_;             // FIO's parameters in declaration order
   std::vector<std::pair<std::string, T>> globals_;  // read everywhere, written by FB bodies, Step and Main
   std::vector<std::string> loop_vars_;   // FOR control variables not in use by an outer loop
   std::vector<std::string> while_vars_;  // WHILE/REPEAT counters not in use
@@ -219,6 +224,17 @@ std::string Gen::leaf(T t, const Scope& s) {
     if (p.t == t) ok.push_back(&p);
   if (ok.empty() || chance(25)) return literal(t);
   return place_text(*ok[pick(static_cast<int>(ok.size()))], s, 0);
+}
+
+std::string Gen::date_literal() {
+  return "D#" + std::to_string(1970 + pick(130)) + "-" + two(1 + pick(12)) + "-" + two(1 + pick(28));
+}
+std::string Gen::tod_literal() {
+  return "TOD#" + two(pick(24)) + ":" + two(pick(60)) + ":" + two(pick(60)) + "." + std::to_string(100 + pick(900));
+}
+std::string Gen::dt_literal() {
+  std::string d = date_literal();
+  return "DT#" + d.substr(2) + "-" + two(pick(24)) + ":" + two(pick(60)) + ":" + two(pick(60));
 }
 
 std::string Gen::call_text(const Callable& c, const Scope& s, int depth) {
@@ -312,6 +328,17 @@ std::string Gen::expr(T t, const Scope& s, int depth) {
       return std::string(name(from)) + "_TO_" + name(t) + "(" + sub(from) + ")";
     });
     if (t == T::Int) alts.push_back([&] { return "LEN(" + sub(T::Str) + ")"; });
+    if (t == T::Dint || t == T::Udint || t == T::Lint) {
+      // Dates as counts: DATE/DT seconds since 1970-01-01, TOD ms or s since midnight.
+      std::string tn = name(t);
+      alts.push_back([&, tn] { return "DATE_TO_" + tn + "(" + date_literal() + ")"; });
+      alts.push_back([&, tn] { return "DT_TO_" + tn + "(" + dt_literal() + ")"; });
+      alts.push_back([&, tn] { return "TOD_TO_" + tn + "(" + tod_literal() + ")"; });
+      alts.push_back([&, tn] { return "DT_TO_" + tn + "(DINT_TO_DT(" + sub(T::Dint) + ") + " + sub(T::Time) + ")"; });
+      alts.push_back([&, tn] { return "TOD_TO_" + tn + "(" + tod_literal() + " - " + sub(T::Time) + ")"; });
+      alts.push_back([&, tn] { return "TIME_TO_" + tn + "(DINT_TO_TOD(" + sub(T::Dint) + ") - " + tod_literal() + ")"; });
+      alts.push_back([&, tn] { return "TIME_TO_" + tn + "(" + date_literal() + " - UDINT_TO_DATE(" + sub(T::Udint) + "))"; });
+    }
   }
   if (is_bits(t)) {
     alts.push_back([&] {
@@ -515,7 +542,7 @@ std::string Gen::stmt(const Scope& s, int depth) {
     const auto& [n, ps] = refs_[static_cast<size_t>(pick(static_cast<int>(refs_.size())))];
     return n + " := REF(" + place_text(ps[static_cast<size_t>(pick(static_cast<int>(ps.size())))], s, 1) + ");";
   }
-  if (s.fb_statements && r < 51) {
+  if (s.fb_statements && r < 56) {
     std::vector<const Place*> io;
     for (const auto* p : w)
       if (p->t == fio_type_ && !p->bit) io.push_back(p);
@@ -527,15 +554,25 @@ std::string Gen::stmt(const Scope& s, int depth) {
     if (io.size() >= 2 && !plain.empty()) {
       const Place* dst = plain[static_cast<size_t>(pick(static_cast<int>(plain.size())))];
       const Place* ref = io[static_cast<size_t>(pick(static_cast<int>(io.size())))];
-      return place_text(*dst, s, 1) + " := FIO(io := " + place_text(*ref, s, 1) + ", a := " + expr(fio_type_, s, ed) + ");";
+      const Place* out = plain[static_cast<size_t>(pick(static_cast<int>(plain.size())))];
+      std::map<std::string, std::string> arg{{"io", place_text(*ref, s, 1)}, {"a", expr(fio_type_, s, ed)}, {"o", place_text(*out, s, 1)}};
+      std::string call = "FIO(";
+      if (chance(50)) {  // non-formal: declaration order, a trailing output may be left out
+        size_t n = fio_order_.back() == "o" && chance(50) ? 2 : 3;
+        for (size_t i = 0; i < n; ++i) call += (i ? ", " : "") + arg[fio_order_[i]];
+      } else {
+        call += "io := " + arg["io"] + ", a := " + arg["a"];
+        if (chance(50)) call += ", o => " + arg["o"];
+      }
+      return place_text(*dst, s, 1) + " := " + call + ");";
     }
   }
-  if (s.fb_statements && r < 53) {
+  if (s.fb_statements && r < 58) {
     // Whole structures copied in both directions.
     std::string i = "rs[LIMIT(DINT#1, " + expr(T::Dint, s, 1) + ", DINT#3)]";
     return chance(50) ? "r1 := " + i + ";" : i + " := r1;";
   }
-  if (s.fb_statements && r < 56) {
+  if (s.fb_statements && r < 61) {
     const char* kTargets[] = {"ia", "ib", "id"};
     return "IF " + expr(T::Bool, s, 2) + " THEN itf := " + kTargets[pick(3)] + "; ELSE itf := ib; END_IF;";
   }
@@ -785,11 +822,18 @@ std::string Gen::program() {
   {
     fio_type_ = any_scalar();
     std::string tt = type_text(fio_type_);
-    out_ << "FUNCTION FIO : " << tt << "\nVAR_IN_OUT\n  io : " << tt << ";\nEND_VAR\nVAR_INPUT\n  a : " << tt
-         << ";\nEND_VAR\n";
+    // Its in-out, input and output in one of the six orders: a non-formal call binds in
+    // declaration order, whatever the sections' order (and VAR_INPUT CONSTANT is an input
+    // like any other to its callers).
+    fio_order_ = {"io", "a", "o"};
+    for (size_t i = fio_order_.size(); i > 1; --i) std::swap(fio_order_[i - 1], fio_order_[static_cast<size_t>(pick(static_cast<int>(i)))]);
+    out_ << "FUNCTION FIO : " << tt << "\n";
+    for (const auto& n : fio_order_)
+      out_ << (n == "io" ? "VAR_IN_OUT" : n == "a" ? (chance(50) ? "VAR_INPUT CONSTANT" : "VAR_INPUT") : "VAR_OUTPUT") << "\n  " << n
+           << " : " << tt << ";\nEND_VAR\n";
     Scope fs;
     fs.calls = functions_;
-    fs.places = {Place{"io", "", fio_type_, true}, Place{"a", "", fio_type_, false}};
+    fs.places = {Place{"io", "", fio_type_, true}, Place{"a", "", fio_type_, false}, Place{"o", "", fio_type_, true}};
     out_ << stmts(fs, 2, 1, "\n") << "\n" << assign(Place{"FIO", "", fio_type_, true}, fs, 2) << "\nEND_FUNCTION\n\n";
   }
   // A FUNCTION taking an interface: dispatch through a parameter.

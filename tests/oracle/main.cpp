@@ -62,8 +62,9 @@ bool same(const st::Machine& m, const st::VarHandle& h, const Value& v, std::str
   switch (v.t->kind) {
     case VK::Bool: return st::read_bool(m, h) == (v.i != 0);
     case VK::Int:
-    case VK::Time: {
-      uint64_t mask = v.t->bits == 64 || v.t->kind == VK::Time ? ~uint64_t{0} : (uint64_t{1} << v.t->bits) - 1;
+    case VK::Time:
+    case VK::Date: {
+      uint64_t mask = v.t->bits == 64 || v.t->kind != VK::Int ? ~uint64_t{0} : (uint64_t{1} << v.t->bits) - 1;
       return (static_cast<uint64_t>(st::read_int(m, h)) & mask) == (static_cast<uint64_t>(v.i) & mask);
     }
     case VK::Real:
@@ -78,9 +79,13 @@ bool same(const st::Machine& m, const st::VarHandle& h, const Value& v, std::str
 
 // Compiles and runs one program in the interpreter (and natively when asked) and in the
 // reference evaluator, comparing every variable after every scan.
+// The dialect every program is compiled and evaluated in (--dialect).
+bool g_codesys = false;
+
 Outcome check(const std::string& name, const std::string& text, int scans, bool native, bool wrong_reference = false) {
   st::CompileOptions copt;
   copt.warnings = false;
+  if (g_codesys) copt.dialect = st::Dialect::Codesys;
   auto b = st::build_sources({{name, text}}, copt);
   if (!b->ok()) return {Kind::CompileError, b->diags.render_all()};
   const st::Application& app = *b->app;
@@ -92,6 +97,7 @@ Outcome check(const std::string& name, const std::string& text, int scans, bool 
   try {
     ref = std::make_unique<Reference>(std::vector<const st::CompilationUnit*>{unit.get()});
     ref->set_wrong_addition(wrong_reference);
+    ref->set_codesys(g_codesys);
   } catch (const Unsupported& e) {
     return {Kind::Unsupported, e.what()};
   } catch (const RefTrap& e) {
@@ -278,7 +284,7 @@ int usage() {
   std::fprintf(stderr,
                "usage: plcfi_oracle [--seed S] [--count N] [--scans K] [--native | --no-native]\n"
                "                    [--native-every M] [--out DIR] [--avoid method-args-with-calls]\n"
-               "                    [--shrink-first N | --no-shrink] [--verbose] [FILE.st ...]\n"
+               "                    [--shrink-first N | --no-shrink] [--verbose] [--dialect iec|codesys] [FILE.st ...]\n"
                "       plcfi_oracle --seed S [--avoid ...] --emit     (prints the program of seed S)\n"
                "       plcfi_oracle --self-check [--seed S --count N] (a wrong reference must be caught)\n"
                "Generates N programs from seeds S, S+1, ... (or takes the given files), runs K scans of each\n"
@@ -310,6 +316,14 @@ int run(int argc, char** argv) {
       else if (a == "--no-shrink") o.shrink_first = 0;
       else if (a == "--shrink-first") o.shrink_first = std::stoull(next());
       else if (a == "--verbose") o.verbose = true;
+      else if (a == "--dialect") {
+        std::string d = next();
+        if (d != "iec" && d != "codesys") {
+          std::fprintf(stderr, "plcfi_oracle: --dialect must be iec or codesys, not '%s'\n", d.c_str());
+          return 2;
+        }
+        g_codesys = d == "codesys";
+      }
       else if (a == "--self-check") o.self_check = true;
       else if (a == "--emit") {  // prints the program of --seed and stops
         std::fputs(generate_program(o.seed, o.gen).c_str(), stdout);

@@ -75,7 +75,8 @@ Reference::Reference(const std::vector<const st::CompilationUnit*>& units) {
       {"UINT", VK::Int, 16, false},   {"UDINT", VK::Int, 32, false},  {"ULINT", VK::Int, 64, false},
       {"BYTE", VK::Int, 8, false},    {"WORD", VK::Int, 16, false},   {"DWORD", VK::Int, 32, false},
       {"LWORD", VK::Int, 64, false},  {"REAL", VK::Real, 32, false},  {"LREAL", VK::LReal, 64, false},
-      {"TIME", VK::Time, 64, true},
+      {"TIME", VK::Time, 64, true},   {"DATE", VK::Date, 64, true},   {"TOD", VK::Date, 64, true},
+      {"DT", VK::Date, 64, true},
   };
   for (const auto& e : kElems) {
     auto t = std::make_unique<RType>();
@@ -106,6 +107,13 @@ Reference::Reference(const std::vector<const st::CompilationUnit*>& units) {
 }
 
 Reference::~Reference() = default;
+
+// Nanoseconds per count when a date converts to a number: DATE and DT count seconds since
+// 1970-01-01 in both dialects, TIME_OF_DAY milliseconds (CODESYS) or seconds (MATIEC).
+int64_t Reference::count_unit(const RType* t) const {
+  if (t->name == "TOD") return codesys_ ? 1'000'000 : 1'000'000'000;
+  return 1'000'000'000;
+}
 
 const RType* Reference::elementary(const std::string& c) const {
   auto it = named_.find(c);
@@ -490,6 +498,10 @@ void Reference::assign(Value& dst, const Value& src) {
       if (src.t->kind != VK::Time) throw Unsupported("assignment to TIME from " + src.t->name);
       dst.i = src.i;
       return;
+    case VK::Date:
+      if (src.t != dst.t) throw Unsupported("assignment to " + dst.t->name + " from " + src.t->name);
+      dst.i = src.i;
+      return;
     case VK::String:
       if (src.t->kind != VK::String) throw Unsupported("assignment to STRING from " + src.t->name);
       dst.s = src.s.substr(0, dst.t->max_len);
@@ -544,6 +556,13 @@ Value Reference::eval(const st::Expr& e, Env& env) {
         case st::LiteralKind::Time:
           if (l.is_long) throw Unsupported("LTIME");
           v.t = elementary("TIME");
+          v.i = l.time_ns;
+          return v;
+        case st::LiteralKind::Date:
+        case st::LiteralKind::TimeOfDay:
+        case st::LiteralKind::DateTime:
+          if (l.is_long) throw Unsupported("long date literal");
+          v.t = elementary(l.lit == st::LiteralKind::Date ? "DATE" : l.lit == st::LiteralKind::TimeOfDay ? "TOD" : "DT");
           v.i = l.time_ns;
           return v;
         case st::LiteralKind::String:
@@ -659,6 +678,19 @@ Value Reference::binary(st::BinaryOp op, const Value& a, const Value& b) {
     }
     return v;
   }
+  // Dates: DT/TOD +- TIME is a date of the same type, the difference of two dates a TIME.
+  if (a.t->kind == VK::Date && b.t->kind == VK::Time && (op == B::Add || op == B::Sub) && a.t->name != "DATE") {
+    v.t = a.t;
+    v.i = static_cast<int64_t>(op == B::Add ? static_cast<uint64_t>(a.i) + static_cast<uint64_t>(b.i)
+                                            : static_cast<uint64_t>(a.i) - static_cast<uint64_t>(b.i));
+    return v;
+  }
+  if (a.t->kind == VK::Date && a.t == b.t && op == B::Sub) {
+    v.t = elementary("TIME");
+    v.i = static_cast<int64_t>(static_cast<uint64_t>(a.i) - static_cast<uint64_t>(b.i));
+    return v;
+  }
+  if (a.t->kind == VK::Date && a.t == b.t && is_cmp) return cmp(a.i < b.i ? -1 : a.i > b.i ? 1 : 0);
   // Implicit widening of integers (SINT -> INT -> DINT -> LINT, USINT -> ... -> ULINT, an
   // unsigned type to a wider signed one): the narrower operand takes the wider type.
   if (a.t->kind == VK::Int && b.t->kind == VK::Int && a.t != b.t) {
@@ -766,6 +798,10 @@ Value Reference::convert(const Value& v, const RType* to) {
         r.i = norm(to, static_cast<uint64_t>(v.i));
         return r;
       }
+      if (from == VK::Date || from == VK::Time) {  // a count of the type's unit, truncated toward zero
+        r.i = norm(to, static_cast<uint64_t>(v.i / (from == VK::Time ? 1'000'000 : count_unit(v.t))));
+        return r;
+      }
       if (from == VK::Real) {
         r.i = saturate<float>(std::nearbyint(static_cast<float>(v.r)), to);
         return r;
@@ -792,6 +828,12 @@ Value Reference::convert(const Value& v, const RType* to) {
       r.r = to->kind == VK::Real ? static_cast<double>(static_cast<float>(d)) : d;
       return r;
     }
+    case VK::Date:
+      if (from == VK::Int && (v.t->is_signed ? v.t->bits <= 32 : v.t->bits < 64)) {
+        r.i = v.i * count_unit(to);
+        return r;
+      }
+      break;
     case VK::Time:
       // DINT_TO_TIME: the integer counts milliseconds.
       if (from == VK::Int && v.t->is_signed && v.t->bits <= 32) {
@@ -841,23 +883,32 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owne
   // Arguments are evaluated in the caller's frame first, left to right, then bound.
   std::vector<std::pair<std::string, Value>> inputs;
   std::vector<std::pair<std::string, Value*>> in_outs;
-  std::vector<std::string> input_order;
-  std::map<std::string, bool> is_in_out;
+  // A non-formal call binds its arguments in declaration order over inputs, in-outs and
+  // outputs, whatever the order of the sections; an argument at an output receives it.
+  std::vector<std::string> param_order;
+  std::map<std::string, bool> is_in_out, is_output;
   for (const auto& b : pou.var_blocks)
     for (const auto& d : b.decls)
       for (const auto& n : d.names) {
-        if (b.section == st::VarSection::Input || b.section == st::VarSection::InOut) input_order.push_back(canon(n.text));
+        if (b.section == st::VarSection::Input || b.section == st::VarSection::InOut || b.section == st::VarSection::Output)
+          param_order.push_back(canon(n.text));
         if (b.section == st::VarSection::InOut) is_in_out[canon(n.text)] = true;
+        if (b.section == st::VarSection::Output) is_output[canon(n.text)] = true;
       }
+  std::vector<std::pair<std::string, const st::Expr*>> out_args;  // output name, destination
   if (c) {
     size_t pos = 0;
     for (const auto& a : c->args) {
       if (a.negate) throw Unsupported("negated output argument");
-      if (a.is_output) continue;  // stored after the call
-      std::string name = a.name ? canon(a.name->text) : (pos < input_order.size() ? input_order[pos] : "");
+      if (a.is_output) {  // stored after the call
+        out_args.emplace_back(canon(a.name->text), a.value.get());
+        continue;
+      }
+      std::string name = a.name ? canon(a.name->text) : (pos < param_order.size() ? param_order[pos] : "");
       if (name.empty()) throw Unsupported("too many positional arguments");
-      ++pos;
-      if (is_in_out.count(name)) in_outs.emplace_back(name, lvalue(*a.value, caller));
+      if (!a.name) ++pos;
+      if (is_output.count(name)) out_args.emplace_back(name, a.value.get());
+      else if (is_in_out.count(name)) in_outs.emplace_back(name, lvalue(*a.value, caller));
       else inputs.emplace_back(name, eval(*a.value, caller));
     }
   }
@@ -876,14 +927,13 @@ Value Reference::run_pou(const st::Pou& pou, Instance* self, const st::Pou* owne
   }
   for (auto& [name, place] : in_outs) frame.aliases[name] = place;
   exec(pou.body, env);
-  if (c)
-    for (const auto& a : c->args)
-      if (a.is_output && a.value) {
-        Value* out = frame.find(canon(a.name->text));
-        if (!out) throw Unsupported("unknown output " + a.name->text);
-        Value copy = *out;
-        store(*a.value, copy, caller);
-      }
+  for (const auto& [name, dst] : out_args)
+    if (dst) {
+      Value* out = frame.find(name);
+      if (!out) throw Unsupported("unknown output " + name);
+      Value copy = *out;
+      store(*dst, copy, caller);
+    }
   if (!result_type || setter_value) return no_value();
   return *frame.find(canon(result_name));
 }
@@ -1128,7 +1178,7 @@ std::string Reference::text(const Value& v) {
       std::snprintf(buf, sizeof buf, "%.17g", v.r);
       return buf;
     }
-    case VK::Time: return std::to_string(v.i) + "ns";
+    case VK::Time: case VK::Date: return std::to_string(v.i) + "ns";
     case VK::String: return "'" + v.s + "'";
     default: return "?";
   }

@@ -23,7 +23,8 @@ struct RefTrap : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class VK { Bool, Int, Real, LReal, Time, String, Struct, Array, Fb, Itf, Ref };
+// Date: DATE, TOD and DT (by name), held in nanoseconds like TIME.
+enum class VK { Bool, Int, Real, LReal, Time, Date, String, Struct, Array, Fb, Itf, Ref };
 
 struct RType {
   VK kind = VK::Int;
@@ -87,6 +88,8 @@ class Reference {
   // Self-check of the oracle: integer additions yield one more than they should, so that
   // every comparison that reaches such a value must fail.
   void set_wrong_addition(bool on) { wrong_addition_ = on; }
+  // CODESYS/TwinCAT conversions of TIME_OF_DAY (milliseconds) instead of MATIEC's seconds.
+  void set_codesys(bool on) { codesys_ = on; }
 
  private:
   struct Env;
@@ -130,6 +133,8 @@ class Reference {
   const RType* string255_ = nullptr;
   uint64_t steps_ = 0;
   bool wrong_addition_ = false;
+  bool codesys_ = false;
+  int64_t count_unit(const RType* t) const;
 };
 
 }  // namespace plcfi::oracle

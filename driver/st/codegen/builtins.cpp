@@ -164,6 +164,21 @@ Emitter emitter_of(StdFamily f) {
   return nullptr;
 }
 
+
+// The unit a time-like value counts in when converted to or from a number, in the
+// engine's nanoseconds. CODESYS and TwinCAT store TIME in ms, LTIME in ns, DATE and
+// DATE_AND_TIME in seconds since 1970-01-01 and TIME_OF_DAY in ms since midnight, and
+// their conversions give those counts. MATIEC (--dialect iec) converts DATE, DT and TOD
+// to whole seconds (its tv_sec); TIME keeps plcfi's milliseconds in both dialects.
+int64_t count_unit_ns(TypeKind k, Dialect dialect) {
+  switch (k) {
+    case TypeKind::Time: return 1'000'000;
+    case TypeKind::Date: case TypeKind::DateTime: return 1'000'000'000;
+    case TypeKind::TimeOfDay: return dialect == Dialect::Codesys ? 1'000'000 : 1'000'000'000;
+    default: return 1;
+  }
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ arguments, natives
@@ -308,8 +323,10 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
   };
   TypeKind fk = from->kind;
   TypeKind tk = to->kind;
-  bool from_dur_ms = fk == TypeKind::Time;
-  bool to_dur_ms = tk == TypeKind::Time;
+  // Nanoseconds per count when a time-like value becomes a number and back (see
+  // count_unit_ns): the unit is the one the PLC stores the type in.
+  int64_t from_unit = count_unit_ns(fk, opt_.dialect);
+  int64_t to_unit = count_unit_ns(tk, opt_.dialect);
   switch (kind) {
     case ConversionKind::None:
       if (!conv.trunc) return std::nullopt;
@@ -362,12 +379,11 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
       return slot_val(to, t);
     }
     case ConversionKind::TimeToNumber: {
-      // TIME counts in milliseconds when converted to numbers (as CODESYS and TwinCAT do).
-      Slot x = from_dur_ms ? mul(s, 1'000'000, Op::DIV_I8) : s;
-      if (to->is_real() && from_dur_ms) {
+      Slot x = from_unit != 1 ? mul(s, from_unit, Op::DIV_I8) : s;
+      if (to->is_real() && from_unit != 1) {
         Slot f = convert(s, I64, F64);
         Slot d = temp(8, 8);
-        emit(Op::DIV_F64, {d, f, konst(F64, ConstV{ConstV::K::Real, 0, 1e6, {}}, c.loc)});
+        emit(Op::DIV_F64, {d, f, konst(F64, ConstV{ConstV::K::Real, 0, static_cast<double>(from_unit), {}}, c.loc)});
         return slot_val(to, convert(d, F64, to));
       }
       return slot_val(to, convert(x, I64, to));
@@ -376,11 +392,11 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
       if (from->is_real()) {
         Slot f = convert(s, from, F64);
         Slot d = temp(8, 8);
-        emit(Op::MUL_F64, {d, f, konst(F64, ConstV{ConstV::K::Real, 0, to_dur_ms ? 1e6 : 1.0, {}}, c.loc)});
+        emit(Op::MUL_F64, {d, f, konst(F64, ConstV{ConstV::K::Real, 0, static_cast<double>(to_unit), {}}, c.loc)});
         return slot_val(to, convert(d, F64, I64));
       }
       Slot x = convert(s, from, I64);
-      return slot_val(to, to_dur_ms ? mul(x, 1'000'000, Op::MUL_I8) : x);
+      return slot_val(to, to_unit != 1 ? mul(x, to_unit, Op::MUL_I8) : x);
     }
     case ConversionKind::Round: {
       // REAL_TO_INT rounds to the nearest integer, exact halves to the even one (IEC 61131-3

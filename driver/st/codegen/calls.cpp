@@ -195,6 +195,15 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
 // ------------------------------------------------------------------ functions
 
 namespace {
+// How many arguments a non-formal call must give: every parameter up to the last input or
+// in-out (outputs after it may be left out, their values then not captured).
+size_t non_formal_needed(const std::vector<Symbol*>& order) {
+  size_t needed = 0;
+  for (size_t i = 0; i < order.size(); ++i)
+    if (order[i]->section != VarSection::Output) needed = i + 1;
+  return needed;
+}
+
 // The names an expression mentions (reads, or passes on to a call that may write them);
 // false for a form this does not look into.
 bool mentions(const Expr* e, std::set<std::string>* out) {
@@ -382,6 +391,7 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
   std::vector<const Symbol*> stored;  // parameters this call writes into the frame
   std::vector<Symbol*> params = f->inputs;
   params.insert(params.end(), f->inouts.begin(), f->inouts.end());
+  const std::vector<Symbol*> order = positional_params(f);
   size_t pos = 0;
   struct OutCapture {
     Symbol* sym;
@@ -402,14 +412,14 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
         continue;
       }
     } else {
-      if (pos >= params.size()) {
-        diags_.error("ST210", a.loc, f->name + " takes " + std::to_string(params.size()) + " argument(s)");
+      if (pos >= order.size()) {
+        diags_.error("ST210", a.loc, f->name + " takes " + std::to_string(order.size()) + " argument(s)");
         break;
       }
-      p = params[pos++];
+      p = order[pos++];
     }
     if (a.is_output || p->section == VarSection::Output) {
-      if (!a.is_output) {
+      if (!a.is_output && a.name) {
         diags_.error("ST210", a.loc, "'" + p->name + "' is an output: capture it with '" + p->name + " => var'");
         continue;
       }
@@ -441,11 +451,13 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
   }
   // A non-formal call lists every input in order (IEC 61131-3 6.6.1.4.2); only a formal
   // call may leave inputs at their initial values.
+  // Outputs after the last input may be left out (their values are then not captured).
   bool any_named = std::any_of(c.args.begin(), c.args.end(), [](const CallArg& a) { return a.name.has_value(); });
-  if (!any_named && pos > 0 && pos < params.size())
+  size_t needed = non_formal_needed(order);
+  if (!any_named && pos > 0 && pos < needed)
     diags_.error("ST210", c.loc,
                  fmt::format("{} takes {} argument(s), {} given; a non-formal call lists every input (or name them: {}({} := ...))",
-                             f->name, params.size(), pos, f->name, params[pos]->name));
+                             f->name, needed, pos, f->name, order[pos]->name));
   else
     for (size_t i = 0; i < params.size(); ++i)
       if (!given[i] && params[i]->where == Where::InOut)
@@ -490,6 +502,7 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     own.insert(own.end(), f->inouts.begin(), f->inouts.end());
     params.insert(params.begin(), own.begin(), own.end());
   }
+  const std::vector<Symbol*> order = positional_params(fb);
   size_t pos = 0;
   std::vector<Symbol*> passed;
   for (const auto& a : c.args) {
@@ -501,14 +514,14 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
         continue;
       }
     } else {
-      if (pos >= params.size()) {
+      if (pos >= order.size()) {
         diags_.error("ST210", a.loc, "too many arguments for " + fb->name);
         break;
       }
-      p = params[pos++];
+      p = order[pos++];
     }
     if (a.is_output || p->section == VarSection::Output) {
-      if (!a.is_output) {
+      if (!a.is_output && a.name) {
         diags_.error("ST210", a.loc, "'" + p->name + "' is an output of " + fb->name + ": write '" + p->name + " => var'");
         continue;
       }
@@ -657,9 +670,12 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
       if (f.param == p) return &f;
     return nullptr;
   };
-  // Positional arguments go to the parameters the compiler does not supply itself.
+  // Positional arguments go to the parameters the compiler does not supply itself, in
+  // declaration order (outputs among them).
+  std::vector<Symbol*> by_position;
+  for (Symbol* p : positional_params(m))
+    if (!fixed_of(p)) by_position.push_back(p);
   size_t pos = 0;
-  while (pos < params.size() && fixed_of(params[pos])) ++pos;
   for (const auto& a : args) {
     size_t idx = SIZE_MAX;
     if (a.name) {
@@ -677,11 +693,16 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
         continue;
       }
     } else {
-      idx = pos++;
-      if (idx >= params.size()) {
+      if (pos >= by_position.size()) {
         diags_.error("ST210", a.loc, "too many arguments for method " + m->name);
         break;
       }
+      Symbol* p = by_position[pos++];
+      if (p->section == VarSection::Output) {
+        outs.emplace_back(p, &a);
+        continue;
+      }
+      idx = static_cast<size_t>(std::find(params.begin(), params.end(), p) - params.begin());
     }
     if (bound[idx]) {
       diags_.error("ST212", a.loc, "'" + params[idx]->name + "' of " + m->name + " is given twice");

@@ -198,6 +198,8 @@ class Compiler {
   const Type* named_type(const Ident& name, uint32_t file, bool report = true);
   void layout_struct(Type* t, const std::vector<VarDecl>& members, uint32_t file);
   void declare_vars(PouInfo* p);
+  void order_positional(PouInfo* p);
+  std::vector<Symbol*> positional_params(const PouInfo* p) const;
   // The name under which a method's VAR_INST variable is kept in its owner's instance.
   static std::string inst_var_name(const PouInfo* method, const std::string& var);
   void declare_globals(const std::vector<VarBlock>& blocks, const std::string& scope, uint32_t file);

@@ -537,6 +537,8 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
         if (!c && const_depth_hits_ != hits) too_deep_consts_.insert(&init);
         return c;
       };
+      if (s && s->kind == SymKind::Var && s->constant && is_parameter(*s))
+        return fail("'" + n.name.text + "' is a constant input: its value comes with each call, it is not known here");
       const VarDecl* sd = s && s->kind == SymKind::Var && s->constant ? decl_of(s) : nullptr;
       if (sd && sd->init) {
         auto c = init_value(*sd->init, file);
@@ -549,7 +551,7 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
       if (!s || s->kind != SymKind::Var) {
         // Constants not laid out yet: the POU's own (ARRAY[1..N] before N's block) and globals.
         auto const_init = [&](const VarDecl& d) -> const Expr* {
-          if (!d.constant || !d.init) return nullptr;
+          if (!d.constant || !d.init || d.section == VarSection::Input || d.section == VarSection::InOut) return nullptr;
           for (const auto& nm : d.names)
             if (iequals(nm.text, n.name.text)) return d.init.get();
           return nullptr;
@@ -1109,6 +1111,7 @@ void Compiler::declare_vars(PouInfo* p) {
       }
   p->frame_size = align_up(off, 8);
   decl_pou_ = saved_decl_pou;
+  order_positional(p);
   // A variable of an FB and one of its methods or properties spelt alike would each hide
   // the other in the bodies.
   for (const auto& m : p->methods) {
@@ -1181,6 +1184,33 @@ bool Compiler::implements(const PouInfo* fb, const PouInfo* itf) const {
     todo.insert(todo.end(), i->interfaces.begin(), i->interfaces.end());
   }
   return fb == itf;
+}
+
+// The parameters in the order they are written: sections are laid out input, in-out,
+// output whatever their order in the source, but a non-formal call follows the source.
+void Compiler::order_positional(PouInfo* p) {
+  p->positional.clear();
+  std::vector<Symbol*> params = p->inputs;
+  params.insert(params.end(), p->inouts.begin(), p->inouts.end());
+  params.insert(params.end(), p->outputs.begin(), p->outputs.end());
+  // A property setter's value has no declaration of its own: it is the only parameter.
+  for (Symbol* s : params)
+    if (!sym_src(s).decl) p->positional.push_back(s);
+  for (const VarBlock* blk : src(p).blocks) {
+    if (blk->section != VarSection::Input && blk->section != VarSection::InOut && blk->section != VarSection::Output) continue;
+    for (const auto& d : blk->decls)
+      for (Symbol* s : params)
+        if (sym_src(s).decl == &d) p->positional.push_back(s);
+  }
+}
+
+
+// The order a non-formal call binds in: an FB's inherited parameters first, base FB first.
+std::vector<Symbol*> Compiler::positional_params(const PouInfo* p) const {
+  std::vector<Symbol*> out;
+  for (const PouInfo* f = p; f; f = f->kind == PouKind::Method ? nullptr : f->base)
+    out.insert(out.begin(), f->positional.begin(), f->positional.end());
+  return out;
 }
 
 }  // namespace plcfi::st::detail

@@ -414,7 +414,9 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
           diags_.error("ST230", e.loc, "'" + n.name.text + "' is a value of several enumerations; write Type#" + n.name.text);
           return bad();
         }
-        const VarDecl* sd = s && s->constant ? decl_of(s) : nullptr;
+        // A VAR_INPUT CONSTANT (VAR_IN_OUT CONSTANT) is read-only in its POU but takes the
+        // value each call or instance gives it: never folded to its default.
+        const VarDecl* sd = s && s->constant && !is_parameter(*s) ? decl_of(s) : nullptr;
         if (sd && sd->init && s->type && s->type->is_elementary() && sd->init->kind != ExprKind::ArrayInit &&
             sd->init->kind != ExprKind::StructInit) {
           auto c = const_eval(*sd->init, file_, false);

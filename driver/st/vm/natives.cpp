@@ -121,7 +121,9 @@ void f32_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*
 void f64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", load_as<double>(b))); }
 void bool_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, *b ? "TRUE" : "FALSE"); }
 
-std::string duration_text(int64_t ns) {
+}  // namespace
+
+std::string duration_literal(int64_t ns) {
   std::string out = "T#";
   if (ns < 0) {
     out += '-';
@@ -143,6 +145,7 @@ std::string duration_text(int64_t ns) {
   }
   return out;
 }
+namespace {
 void civil(int64_t days, int* y, unsigned* m, unsigned* d) {  // days since 1970-01-01
   days += 719468;
   int64_t era = (days >= 0 ? days : days - 146096) / 146097;
@@ -171,13 +174,17 @@ std::string tod_part(int64_t ns) {
   if (ms) out += fmt::format(".{:03}", ms);
   return out;
 }
-void time_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, duration_text(load_as<int64_t>(b))); }
-void date_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "D#" + date_part(load_as<int64_t>(b))); }
-void tod_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, "TOD#" + tod_part(load_as<int64_t>(b))); }
-void dt_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  int64_t v = load_as<int64_t>(b);
-  put(a, cap, "DT#" + date_part(v) + "-" + tod_part(v));
-}
+}  // namespace
+
+std::string date_literal(int64_t ns) { return "D#" + date_part(ns); }
+std::string tod_literal(int64_t ns) { return "TOD#" + tod_part(ns); }
+std::string dt_literal(int64_t ns) { return "DT#" + date_part(ns) + "-" + tod_part(ns); }
+
+namespace {
+void time_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, duration_literal(load_as<int64_t>(b))); }
+void date_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, date_literal(load_as<int64_t>(b))); }
+void tod_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, tod_literal(load_as<int64_t>(b))); }
+void dt_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, dt_literal(load_as<int64_t>(b))); }
 
 // Text to numbers: leading/trailing blanks allowed, garbage yields 0 (as PLC runtimes do).
 void s_to_i64(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {

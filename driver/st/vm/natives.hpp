@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 namespace plcfi::st {
 
@@ -21,5 +22,13 @@ enum class Native : uint32_t {
   ARRAY_DIFF,              // a := the first difference of two arrays (vm.cpp: array_difference)
   Count_
 };
+
+// The literal text of a time-like value held in nanoseconds (TIME and LTIME durations,
+// DATE, TIME_OF_DAY and DATE_AND_TIME since 1970-01-01 / midnight): T#1h2m, D#2024-03-01,
+// TOD#01:00:00.250, DT#2024-03-01-01:00:00. What messages, --print and traces show.
+std::string duration_literal(int64_t ns);
+std::string date_literal(int64_t ns);
+std::string tod_literal(int64_t ns);
+std::string dt_literal(int64_t ns);
 
 }  // namespace plcfi::st

@@ -60,6 +60,11 @@ struct Symbol {
   std::vector<uint8_t> init;   // METHOD input: the value an omitted argument gets
 };
 
+// A VAR_INPUT, VAR_IN_OUT or VAR_OUTPUT: its value comes from (or goes to) each call.
+inline bool is_parameter(const Symbol& s) {
+  return s.section == VarSection::Input || s.section == VarSection::InOut || s.section == VarSection::Output;
+}
+
 // Layout and code of one POU (FUNCTION, FUNCTION_BLOCK, PROGRAM, METHOD, INTERFACE).
 // A monitor PROGRAM's state shift (previous := current of each temporal operator, at the
 // first evaluation of a new __state): frame offsets, so a caller may do it natively
@@ -83,6 +88,10 @@ struct PouInfo {
   std::vector<PouInfo*> interfaces;
   std::vector<std::unique_ptr<Symbol>> vars;   // declaration order; parameters first
   std::vector<Symbol*> inputs, outputs, inouts;
+  // This POU's own VAR_INPUT, VAR_IN_OUT and VAR_OUTPUT in declaration order, whatever the
+  // sections' order: the order a non-formal call binds its arguments in (IEC 61131-3
+  // 6.6.1.4.2, as CODESYS and TwinCAT do). An FB's inherited parameters come before these.
+  std::vector<Symbol*> positional;
   std::vector<std::unique_ptr<PouInfo>> methods;
   std::string property;     // property getter/setter: the property's name
   bool is_setter = false;

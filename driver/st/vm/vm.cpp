@@ -3,6 +3,7 @@
 #include "ops.hpp"
 #include "vm.hpp"
 #include "native/native.hpp"
+#include "natives.hpp"
 
 #include <bit>
 #include <cmath>
@@ -887,8 +888,9 @@ std::string format_value(ValueKind k, const uint8_t* p) {
       if (ns % 1'000'000 == 0) return fmt::format("T#{}ms", ns / 1'000'000);
       return fmt::format("T#{}ns", ns);
     }
-    case ValueKind::Date: case ValueKind::Tod: case ValueKind::Dt:
-      return std::to_string(ld<int64_t>(p)) + "ns";
+    case ValueKind::Date: return date_literal(ld<int64_t>(p));
+    case ValueKind::Tod: return tod_literal(ld<int64_t>(p));
+    case ValueKind::Dt: return dt_literal(ld<int64_t>(p));
     case ValueKind::String: return "'" + std::string(reinterpret_cast<const char*>(p)) + "'";
   }
   return "?";
