@@ -271,6 +271,7 @@ class Compiler {
   // ---- expressions, rvalues (expr.cpp)
   Val expr(const Expr& e, const Type* expected = nullptr);
   Val binary(const BinaryExpr& e, const Type* expected);
+  Val short_circuit(const BinaryExpr& e, const Val& l);
   Val combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc);
   Val unary(const UnaryExpr& e, const Type* expected);
   Val literal(const LiteralExpr& e, const Type* expected);

@@ -828,7 +828,7 @@ bool Compiler::locate(const DirectAddrExpr& a, const Type* t, uint32_t* addr, ui
 void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::string& scope, uint32_t file) {
   for (const auto& blk : blocks) {
     for (const auto& d : blk.decls) {
-      init_args_ok_ = !d.location;
+      init_args_ok_ = !d.location || is_unmapped(*d.location);
       const Type* t = d.type ? resolve_type(*d.type, file) : nullptr;
       init_args_ok_ = false;
       if (!t) continue;
@@ -846,7 +846,7 @@ void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::s
         s->retain = d.retain;
         s->loc = n.loc;
         sym_src(s.get()).decl = &d;
-        if (d.location) {
+        if (d.location && !is_unmapped(*d.location)) {
           bool is_bit = false;
           if (!locate(*d.location, t, &s->offset, &s->bit, &is_bit)) continue;
           s->where = is_bit ? Where::AbsBit : Where::Abs;
@@ -892,6 +892,8 @@ void Compiler::check_init_args(const TypeSpec& spec, const Type* t, bool allowed
   for (const PouInfo* f = t->pou; f; f = f->base)
     for (const auto& m : f->methods)
       if (iequals(m->name, "FB_init") && m->has_body) return;
+  // `fb : R_TRIG();`: an empty list asks for nothing beyond the implicit initialisation.
+  if (spec.init_args.empty()) return;
   diags_.error("ST243", at, t->pou->name + " has no FB_init method to take these arguments");
 }
 
@@ -1064,7 +1066,7 @@ void Compiler::declare_vars(PouInfo* p) {
         for (const auto& n : d.names) {
           Symbol* s = add(d, n, t);
           if (!s) continue;
-          if (d.location) {
+          if (d.location && !is_unmapped(*d.location)) {
             bool is_bit = false;
             if (!locate(*d.location, t, &s->offset, &s->bit, &is_bit)) continue;
             s->where = is_bit ? Where::AbsBit : Where::Abs;

@@ -113,6 +113,14 @@ Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* wh
       return bad();
     }
     if (to->kind == TypeKind::Enum) {
+      if (opt_.dialect == Dialect::Codesys && to->base) {  // CODESYS: an integer is an enumeration's value
+        if (opt_.warnings)
+          diags_.warning("ST405", loc, "implicit conversion from an integer to enumeration " + to->name +
+                                           (what ? std::string(" in ") + what : std::string()) + "; write " + to->name + "#Value");
+        Val as_base = coerce(v, to->base, loc, what);
+        if (as_base.ok) as_base.type = to;
+        return as_base;
+      }
       diags_.error("ST203", loc, "cannot use an integer as enumeration " + to->name + "; use " + to->name + "#Value");
       return bad();
     }
@@ -146,6 +154,23 @@ Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* wh
     return out;
   }
   if (opt_.dialect == Dialect::Codesys) {
+    // CODESYS converts between an enumeration and integers implicitly: through its base type.
+    bool enum_to_number = v.type->kind == TypeKind::Enum && v.type->base && (to->is_integer() || to->is_bitstring());
+    bool number_to_enum = to->kind == TypeKind::Enum && to->base && (v.type->is_integer() || v.type->is_bitstring());
+    if (enum_to_number || number_to_enum) {
+      if (opt_.warnings)
+        diags_.warning("ST405", loc, "implicit conversion from " + v.type->name + " to " + to->name +
+                                         (what ? std::string(" in ") + what : std::string()) +
+                                         (enum_to_number ? " (the enumeration's value)" : "; write TO_" + canon(to->base->name) + " or an enumeration value"));
+      Val w = v;
+      if (enum_to_number) {
+        w.type = v.type->base;
+        return coerce(w, to, loc, what);
+      }
+      w = coerce(w, to->base, loc, what);
+      if (w.ok) w.type = to;
+      return w;
+    }
     if (std::optional<Val> p = pointer_conversion(v, to, loc)) return *p;
     if (dialect_converts(v.type, to)) return implicit_conversion(v, to, loc, what);
   }
@@ -602,11 +627,47 @@ Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
   for (size_t k = spine.size(); k-- > 0;) {
     const BinaryExpr& n = *spine[k];
     if (!l.ok) return bad();
+    if (n.op == BinaryOp::AndThen || n.op == BinaryOp::OrElse) {
+      l = short_circuit(n, l);
+      continue;
+    }
     Val r = expr(*n.rhs, l.type && l.type->kind == TypeKind::Enum ? l.type : (is_cmp(n.op) ? nullptr : want[k]));
     if (!r.ok) return bad();
     l = combine(n.op, l, r, n.loc);
   }
   return l;
+}
+
+// a AND_THEN b, a OR_ELSE b (CODESYS): b is evaluated only when a does not decide the
+// result, so `p <> 0 AND_THEN p^ > 0` never reads through a null pointer. `l` is a's value.
+Val Compiler::short_circuit(const BinaryExpr& e, const Val& l) {
+  const char* name = e.op == BinaryOp::AndThen ? "AND_THEN" : "OR_ELSE";
+  if (opt_.dialect == Dialect::Iec) {
+    diags_.error("ST241", e.loc, std::string(name) + " is CODESYS, not IEC 61131-3: use --dialect codesys (or AND/OR)");
+    return bad();
+  }
+  const Type* boolean = elem(TypeKind::Bool);
+  if (!l.type || l.type->kind != TypeKind::Bool) {
+    diags_.error("ST204", e.lhs->loc, std::string(name) + " needs BOOL operands, not " + tname(l.type));
+    return bad();
+  }
+  Slot d = temp(1, 1);
+  Place dst = frame_place(d, boolean);
+  assign(dst, l, e.lhs->loc);
+  Label done = new_label();
+  branch_on(l, e.lhs->loc, done, e.op == BinaryOp::OrElse);
+  Val r = expr(*e.rhs, boolean);
+  if (!r.ok) return bad();
+  if (!r.type || r.type->kind != TypeKind::Bool) {
+    diags_.error("ST204", e.rhs->loc, std::string(name) + " needs BOOL operands, not " + tname(r.type));
+    return bad();
+  }
+  assign(dst, r, e.rhs->loc);
+  bind(done);
+  Val v;
+  v.type = boolean;
+  v.slot = d;
+  return v;
 }
 
 Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {

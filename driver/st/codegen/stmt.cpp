@@ -202,6 +202,10 @@ void Compiler::stmt(const Stmt& s) {
 }
 
 void Compiler::assign_stmt(const AssignStmt& s) {
+  if (s.chained && opt_.dialect == Dialect::Iec) {
+    diags_.error("ST241", s.loc, "a chained assignment (a := b := c) is CODESYS, not IEC 61131-3: write one assignment per statement, or use --dialect codesys");
+    return;
+  }
   if (s.set_reset) {
     // x S= c  ->  IF c THEN x := TRUE; END_IF   (R=: FALSE)
     const char* op = s.set_reset == 'S' ? "S=" : "R=";

@@ -20,6 +20,8 @@ const char* op_text(BinaryOp op) {
     case BinaryOp::And: return "AND";
     case BinaryOp::Xor: return "XOR";
     case BinaryOp::Or: return "OR";
+    case BinaryOp::AndThen: return "AND_THEN";
+    case BinaryOp::OrElse: return "OR_ELSE";
   }
   return "?";
 }

@@ -53,6 +53,7 @@ enum class BinaryOp {
   And,                   // AND, &
   Xor,                   // XOR
   Or,                    // OR
+  AndThen, OrElse,       // AND_THEN, OR_ELSE (CODESYS): the right operand only when needed
 };
 // The operator as written in ST ("<=", "MOD", "AND").
 const char* op_text(BinaryOp op);
@@ -95,6 +96,11 @@ struct DirectAddrExpr : Expr {
   char size = 'X';        // 'X' (bit, also when omitted), 'B', 'W', 'D', 'L'
   std::vector<uint32_t> parts;  // 0.3 -> {0, 3}; %QW2 -> {2}
 };
+
+// `AT %I*`, `AT %Q*`, `AT %M*`: the address is left to the I/O mapping (TwinCAT, CODESYS).
+// plcfi keeps such a variable in ordinary storage; io maps, plant files and campaign
+// bindings reach it by its path (Main.start).
+inline bool is_unmapped(const DirectAddrExpr& a) { return a.parts.empty() && !a.text.empty() && a.text.back() == '*'; }
 
 struct MemberExpr : Expr {
   explicit MemberExpr(SourceLoc l) : Expr(ExprKind::Member, l) {}
@@ -253,7 +259,7 @@ struct VarBlock {
 // ---------------------------------------------------------------- statements
 
 enum class StmtKind {
-  Assign,     // lhs := rhs   (also lhs REF= rhs, and `lhs := ...` chained is not ST)
+  Assign,     // lhs := rhs   (also lhs REF= rhs, S=, R=)
   Call,       // f(...); fb(...); obj.m(...);
   If,
   Case,
@@ -282,6 +288,7 @@ struct AssignStmt : Stmt {
   ExprPtr lhs, rhs;
   bool is_ref_assign = false;  // REF=
   char set_reset = 0;          // 'S' for S= (CODESYS: lhs := TRUE when rhs), 'R' for R= (lhs := FALSE)
+  bool chained = false;        // `b := c` of `a := b := c` (CODESYS), split into `b := c; a := b;`
 };
 
 struct CallStmt : Stmt {

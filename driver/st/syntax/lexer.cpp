@@ -494,10 +494,10 @@ Token Lexer::lex_number() {
     while (pos_ < text_.size() && is_ident_char(text_[pos_])) ++pos_;
     tok = make(Tok::IntLit, begin);
     const std::string_view lit = tok.text;
-    const int base = base_text == "2" ? 2 : base_text == "8" ? 8 : base_text == "16" ? 16 : 0;
+    const int base = base_text == "2" ? 2 : base_text == "8" ? 8 : base_text == "10" ? 10 : base_text == "16" ? 16 : 0;
     if (base == 0) {
       error("ST006", begin, "unsupported base '" + base_text + "' in literal '" + std::string(lit) +
-                                "' (expected 2, 8 or 16)");
+                                "' (expected 2, 8, 10 or 16)");
       tok.bad = true;
       return tok;
     }

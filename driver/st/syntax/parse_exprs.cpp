@@ -18,8 +18,10 @@ namespace {
 int binary_prec(Tok k, BinaryOp* op) {
   switch (k) {
     case Tok::Or: *op = BinaryOp::Or; return 1;
+    case Tok::OrElse: *op = BinaryOp::OrElse; return 1;
     case Tok::Xor: *op = BinaryOp::Xor; return 2;
     case Tok::And: *op = BinaryOp::And; return 3;
+    case Tok::AndThen: *op = BinaryOp::AndThen; return 3;
     case Tok::Amp: *op = BinaryOp::And; return 3;
     case Tok::Eq: *op = BinaryOp::Eq; return 4;
     case Tok::Ne: *op = BinaryOp::Ne; return 4;
@@ -170,6 +172,7 @@ void Parser::parse_call_args(std::vector<CallArg>& args, const std::string& call
   advance();  // '('
   if (accept(Tok::RParen)) return;
   do {
+    if (at(Tok::RParen) && !args.empty()) break;  // `f(a, b, )`: a trailing comma, as CODESYS accepts
     CallArg arg;
     arg.loc = cur().loc;
     if (at(Tok::Not) && la(1).kind == Tok::Ident && la(2).kind == Tok::Arrow) {

@@ -41,6 +41,8 @@ void Parser::parse_stmt_list(StmtList& out, bool case_arm) {
     const size_t before = pos_;
     StmtPtr s = parse_statement();
     if (s) out.push_back(std::move(s));
+    for (auto& more : pending_) out.push_back(std::move(more));  // the rest of a chained assignment
+    pending_.clear();
     if (pos_ == before) {
       error("ST104", cur().loc, "expected a statement, found " + describe(cur()));
       advance();
@@ -93,6 +95,43 @@ StmtPtr Parser::parse_statement() {
   }
 }
 
+namespace {
+// A variable, element, member or dereference: what can stand left of ':='.
+bool is_place(const Expr& e) {
+  return e.kind == ExprKind::Name || e.kind == ExprKind::Member || e.kind == ExprKind::Index || e.kind == ExprKind::Deref;
+}
+}  // namespace
+
+// chained := postfix ':=' postfix ':=' ... expr ';'   (CODESYS: a := b := c)
+// The last target gets the value first, then each target the one to its right: the
+// statements `b := c; a := b;`, the first returned and the others queued for the list.
+// `first` is `a := b` with b parsed from the tokens at `b_start`.
+StmtPtr Parser::parse_chained(std::unique_ptr<AssignStmt> first, size_t b_start) {
+  std::vector<std::unique_ptr<AssignStmt>> chain;
+  std::vector<size_t> starts{b_start};
+  chain.push_back(std::move(first));
+  while (at(Tok::Assign) && is_place(*chain.back()->rhs)) {
+    const SourceLoc at_loc = chain.back()->rhs->loc;
+    advance();  // ':='
+    auto next = std::make_unique<AssignStmt>(at_loc);
+    next->lhs = std::move(chain.back()->rhs);
+    starts.push_back(pos_);
+    next->rhs = parse_expr();
+    chain.push_back(std::move(next));
+  }
+  expect_semi("assignment");
+  const size_t end = pos_;
+  // Each earlier statement reads the target to its right: parsed again from its tokens.
+  for (size_t k = 0; k + 1 < chain.size(); ++k) {
+    pos_ = starts[k];
+    chain[k]->rhs = parse_postfix();
+  }
+  pos_ = end;
+  chain.back()->chained = true;  // the dialect check reports the chain once
+  for (size_t k = chain.size() - 1; k-- > 0;) pending_.push_back(std::move(chain[k]));
+  return std::move(chain.back());
+}
+
 // assignment := postfix (':=' | 'REF=' | 'S=' | 'R=') expr ';'
 // call := postfix '(' call_args ')' ';'
 StmtPtr Parser::parse_assign_or_call() {
@@ -114,7 +153,9 @@ StmtPtr Parser::parse_assign_or_call() {
     auto s = std::make_unique<AssignStmt>(loc);
     s->is_ref_assign = advance().kind == Tok::RefAssign;
     s->lhs = std::move(target);
+    size_t rhs_start = pos_;
     s->rhs = parse_expr();
+    if (!s->is_ref_assign && at(Tok::Assign) && is_place(*s->rhs)) return parse_chained(std::move(s), rhs_start);
     expect_semi("assignment");
     return s;
   }

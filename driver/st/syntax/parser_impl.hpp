@@ -261,6 +261,8 @@ class Parser {
   ExprPtr parse_unary();
   ExprPtr parse_power();
   ExprPtr parse_postfix();
+  StmtPtr parse_chained(std::unique_ptr<AssignStmt> first, size_t b_start);
+  std::vector<StmtPtr> pending_;  // statements a chained assignment adds after the one returned
   ExprPtr parse_primary();
   ExprPtr parse_typed_literal();
   std::unique_ptr<LiteralExpr> literal_from(const Token& t);

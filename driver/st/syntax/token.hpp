@@ -73,6 +73,8 @@ namespace plcfi::st {
   X(Continue, "CONTINUE")                                     \
   X(Return, "RETURN")                                         \
   X(And, "AND")                                               \
+  X(AndThen, "AND_THEN")                                      \
+  X(OrElse, "OR_ELSE")                                        \
   X(Or, "OR")                                                 \
   X(Xor, "XOR")                                               \
   X(Not, "NOT")                                               \

@@ -129,6 +129,8 @@ TEST(Lexer, IntegerLiterals) {
   EXPECT_EQ(one("18446744073709551615").int_value, UINT64_MAX);
   EXPECT_EQ(one("16#FFFFFFFFFFFFFFFF").int_value, UINT64_MAX);
   EXPECT_EQ(one("42").kind, Tok::IntLit);
+  EXPECT_EQ(one("10#0").int_value, 0u);  // an explicit base 10, as TwinCAT code writes it
+  EXPECT_EQ(one("10#1_234").int_value, 1234u);
 }
 
 TEST(Lexer, IntegerErrors) {
@@ -136,7 +138,8 @@ TEST(Lexer, IntegerErrors) {
   EXPECT_EQ(first_code("16#1_0000_0000_0000_0000"), "ST007");
   EXPECT_EQ(first_message("8#19"), "invalid digit '9' in base-8 literal '8#19'");
   EXPECT_EQ(first_code("2#102"), "ST006");
-  EXPECT_EQ(first_code("10#5"), "ST006");
+  EXPECT_EQ(first_code("3#12"), "ST006");
+  EXPECT_EQ(first_code("10#1A"), "ST006");
   EXPECT_EQ(first_code("16#"), "ST005");
   EXPECT_EQ(first_message("12abc"), "invalid numeric literal '12abc'");
 }
