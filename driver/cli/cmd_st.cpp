@@ -232,6 +232,9 @@ int cmd_run(const std::vector<std::string>& args) {
     m.set_now(static_cast<int64_t>(n) * sched.tick_ns());
     m.clear_taken();
     if (!sched.run_due(app, m, n, &trap_text)) status = 1;
+    // What the program logged (ADSLOGSTR, ...), as it happened, beside the trap messages.
+    for (const auto& entry : m.log()) std::cerr << "[" << entry.level << "] " << entry.text << "\n";
+    m.log().clear();
     m.merge_coverage();
     if (status == 0) ++done;
   }

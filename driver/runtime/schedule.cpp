@@ -16,7 +16,7 @@ bool Schedule::from_configuration(const st::Application& app, std::string* err) 
   tasks_.clear();
   for (const auto& t : app.tasks) {
     if (t.programs.empty()) continue;
-    tasks_.push_back(ScheduledTask{t.name, t.interval_ns, t.priority, t.programs});
+    tasks_.push_back(ScheduledTask{t.name, t.interval_ns, t.priority, t.programs, static_cast<uint8_t>(tasks_.size() + 1)});
   }
   if (tasks_.empty()) {
     *err = "the configuration has no task with a program";
@@ -47,7 +47,7 @@ bool Schedule::single_program(const st::Application& app, const std::string& pro
     *err = "several programs (" + names + "): choose one with --program";
     return false;
   }
-  tasks_.push_back(ScheduledTask{"cycle", cycle_ns, 0, match});
+  tasks_.push_back(ScheduledTask{"cycle", cycle_ns, 0, match, 1});
   finish();
   return true;
 }
@@ -72,6 +72,7 @@ bool parse_duration(const std::string& text, int64_t* ns, std::string* err) {
 bool Schedule::run_due(const st::Application& app, st::Machine& m, uint64_t n, std::string* trap) const {
   bool ok = true;
   for_each_due(n, [&](const ScheduledTask& t) {
+    m.set_task_index(t.index);
     for (size_t pi : t.programs) {
       if (!ok) return;
       const auto& inst = app.programs[pi];

@@ -17,6 +17,7 @@ struct ScheduledTask {
   int64_t interval_ns = 0;
   int64_t priority = 0;
   std::vector<size_t> programs;  // indices into Application::programs
+  uint8_t index = 1;  // 1-based, in the configuration's order (GETCURTASKINDEX)
 };
 
 class Schedule {

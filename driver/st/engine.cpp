@@ -71,31 +71,57 @@ size_t find_word(const std::string& text, std::string_view word, size_t from = 0
   return std::string::npos;
 }
 
-// The Tc2 data types the sources name and do not declare (a name followed by ':' but not
-// ':='), as one library text; empty when there are none.
+// Whether the sources name `name` and do not declare it themselves (the name followed by
+// ':' but not ':=', or after FUNCTION/FUNCTION_BLOCK).
+bool named_not_declared(const SourceManager& sm, const std::vector<uint32_t>& files, const char* name) {
+  bool named = false, declared = false;
+  for (uint32_t f : files) {
+    if (is_library_path(sm.file(f).path)) continue;
+    const std::string& src = sm.file(f).text;
+    for (size_t at = find_word(src, name); at != std::string::npos; at = find_word(src, name, at + 1)) {
+      named = true;
+      size_t k = at + std::strlen(name);
+      while (k < src.size() && std::isspace(static_cast<unsigned char>(src[k]))) ++k;
+      if (k < src.size() && src[k] == ':' && (k + 1 >= src.size() || src[k + 1] != '=')) declared = true;
+      size_t b = at;
+      while (b > 0 && std::isspace(static_cast<unsigned char>(src[b - 1]))) --b;
+      for (std::string_view kw : {"FUNCTION_BLOCK", "FUNCTION"})
+        if (b >= kw.size() && iequals(std::string_view(src).substr(b - kw.size(), kw.size()), kw)) declared = true;
+    }
+  }
+  return named && !declared;
+}
+
+// The Tc2 data types the sources name and do not declare, as one library text; empty
+// when there are none.
 std::string tc2_library(const SourceManager& sm, const std::vector<uint32_t>& files) {
   std::string text;
-  for (const Tc2Type& t : tc2_types()) {
-    bool named = false, declared = false;
-    for (uint32_t f : files) {
-      if (is_library_path(sm.file(f).path)) continue;
-      const std::string& src = sm.file(f).text;
-      for (size_t at = find_word(src, t.name); at != std::string::npos; at = find_word(src, t.name, at + 1)) {
-        named = true;
-        size_t k = at + std::strlen(t.name);
-        while (k < src.size() && std::isspace(static_cast<unsigned char>(src[k]))) ++k;
-        if (k < src.size() && src[k] == ':' && (k + 1 >= src.size() || src[k + 1] != '=')) declared = true;
-      }
+  for (const Tc2Type& t : tc2_types())
+    if (named_not_declared(sm, files, t.name)) text += t.source;
+  return text;
+}
+
+// The same for the items of Tc2_System, each with the item its source uses.
+std::string tc2_system_library(const SourceManager& sm, const std::vector<uint32_t>& files) {
+  std::set<std::string> wanted;
+  for (const Tc2Item& item : tc2_system_items())
+    if (named_not_declared(sm, files, item.name)) {
+      wanted.insert(item.name);
+      if (item.needs) wanted.insert(item.needs);
     }
-    if (named && !declared) text += t.source;
-  }
+  std::string text;
+  for (const Tc2Item& item : tc2_system_items())
+    if (wanted.count(item.name)) text += item.source;
   return text;
 }
 
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> files, const CompileOptions& opt,
                               const GeneratedSources& late, const std::set<uint32_t>& imported = {}) {
-  if (opt.dialect == Dialect::Codesys)
+  if (opt.dialect == Dialect::Codesys) {
     if (std::string tc2 = tc2_library(b->sm, files); !tc2.empty()) files.insert(files.begin() + 1, b->sm.add("<Tc2>", tc2));
+    if (std::string sys = tc2_system_library(b->sm, files); !sys.empty())
+      files.insert(files.begin() + 1, b->sm.add("<Tc2_System>", sys));
+  }
   if (uses_library(b->sm, files, "fb_testsuite")) files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
   if (uses_library(b->sm, files, "fb_assert")) files.insert(files.begin() + 1, b->sm.add("<FB_ASSERT>", fb_assert_source()));
   for (uint32_t f : files) {

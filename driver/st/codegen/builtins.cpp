@@ -159,6 +159,7 @@ Emitter emitter_of(StdFamily f) {
     case F::Temporal: return &Compiler::emit_temporal;
     case F::AdvanceTime: return &Compiler::emit_advance_time;
     case F::Assert: return &Compiler::emit_assert;
+    case F::System: return &Compiler::emit_system;
     case F::Count_: break;
   }
   return nullptr;
@@ -267,6 +268,7 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
   // The temporal operators are ordinary names outside monitors (a user's RISING is found
   // before this, and an unknown one is reported as unknown).
   if (f->late_only() && (!b_->pou || !is_late(b_->pou))) return std::nullopt;
+  if (f->codesys_only() && opt_.dialect != Dialect::Codesys) return std::nullopt;
   if (f->test_only() && !b_->in_test) {
     diags_.error("ST211", c.loc, name + " is only available in TEST, SETUP and TEARDOWN blocks of test files");
     return bad();
@@ -737,7 +739,54 @@ std::optional<Val> Compiler::emit_sizeof(const StdFunc& f, const CallExpr& c) {
   return out;
 }
 
-std::optional<Val> Compiler::emit_now(const StdFunc&, const CallExpr&) {
+// The Tc2_System functions: each argument converted to its operand's type as a call of
+// the library's function would convert it, then the native helper (vm/natives.cpp).
+std::optional<Val> Compiler::emit_system(const StdFunc& f, const CallExpr& c) {
+  auto args = positional(c, f);
+  if (args.size() != std::string_view(f.operands).size()) return bad();
+  auto type_of = [&](char k) -> const Type* {
+    switch (k) {
+      case 'A': case 'U': return elem(TypeKind::UDInt);
+      case 'Y': return elem(TypeKind::USInt);
+      case 'W': return elem(TypeKind::DWord);
+      case 'D': return elem(TypeKind::DInt);
+      case 'F': return elem(TypeKind::LReal);
+      default: return tt_->string_type(255, false);
+    }
+  };
+  std::vector<Slot> slots;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const char k = f.operands[i];
+    if (k == 'S') {
+      auto s = str_arg(*this, args[i], f.name);
+      if (!s) return bad();
+      slots.push_back(*s);
+      continue;
+    }
+    Val v = expr(*args[i]);
+    if (!v.ok) return bad();
+    const Type* to = type_of(k);
+    // An address may be a pointer or a reference (ADR(x), a POINTER TO variable): its
+    // value is the address, a UDINT in this engine.
+    if (k == 'A' && v.type && v.type->kind == TypeKind::Ref) {
+      slots.push_back(v.slot);
+      continue;
+    }
+    const std::string what = std::string(f.name) + "'s " + f.params[i];
+    Val cv = coerce(v, to, args[i]->loc, what.c_str());
+    if (!cv.ok) return bad();
+    slots.push_back(to_slot(cv, to, args[i]->loc));
+  }
+  const Type* result = f.result == 'Y' ? elem(TypeKind::Byte) : type_of(f.result);
+  mark(c.loc);  // a trap of the function (MEMCPY outside the memory) points at the call
+  return native_list(f.native, result, slots, 0);
+}
+
+std::optional<Val> Compiler::emit_now(const StdFunc& f, const CallExpr& c) {
+  if (!f.extensible() && !c.args.empty()) {  // TIME() takes none; __NOW is the compiler's own
+    diags_.error("ST210", c.loc, std::string(f.name) + " takes no arguments");
+    return bad();
+  }
   Slot d = temp(8, 8);
   emit(Op::NOW, {d});
   def(d);

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "compiler_impl.hpp"
+#include "sema/stdfuncs.hpp"
 
 namespace plcfi::st::detail {
 
@@ -119,7 +120,15 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
         return call_method(c, m, &self, addr_of(self, c.loc), true);
       }
     }
-    diags_.error("ST211", callee.loc, "unknown function '" + n.name.text + "'");
+    // A vendor library's name says which library, so that the fix is clear: the dialect,
+    // or a library plcfi does not have (then the project needs a stand-in of its own).
+    std::string why;
+    if (const char* lib = unprovided_library(n.name.text)) why = ": " + n.name.text + " is from " + lib + ", which plcfi does not provide";
+    else if (const StdFunc* f = find_std_function(key); opt_.dialect != Dialect::Codesys &&
+             ((f && f->codesys_only()) || std::any_of(tc2_system_items().begin(), tc2_system_items().end(),
+                                                      [&](const Tc2Item& t) { return iequals(t.name, key); })))
+      why = " (a function of TwinCAT's Tc2_System: --dialect codesys)";
+    diags_.error("ST211", callee.loc, "unknown function '" + n.name.text + "'" + why);
     return bad();
   }
   if (callee.kind == ExprKind::Member) {

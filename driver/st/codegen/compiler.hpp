@@ -60,12 +60,26 @@ struct Tc2Type {
   const char* source;
 };
 const std::vector<Tc2Type>& tc2_types();
+// What of Beckhoff's Tc2_System plcfi provides in ST: the ADSLOG constants,
+// MAX_STRING_LENGTH, PVOID, BIT, GETCURTASKINDEX, GETCPUCOUNTER, F_GetCpuCounterAs64bit
+// (stdlib/tc2_system.cpp), each item loaded as the Tc2 types are. MEMCPY, ADSLOGSTR and
+// the other functions on memory and the log are built-ins (sema/stdfuncs.cpp).
+struct Tc2Item {
+  const char* name;
+  const char* source;
+  const char* needs;  // another item the source uses, or nullptr
+};
+const std::vector<Tc2Item>& tc2_system_items();
+// The vendor library a name belongs to when plcfi does not provide it ("FB_FileOpen" ->
+// "Tc2_System"), for the message that says so; nullptr for any other name.
+const char* unprovided_library(std::string_view name);
 // The location a TcUnit assertion's hidden input _tcuAt holds (codegen/tcunit.cpp).
 SourceLoc unpack_location(int64_t packed);
 // The libraries plcfi brings, loaded under these names: no warnings, mocks, coverage or
 // listing of their own. (Other sources in memory have names in angle brackets too.)
 inline bool is_library_path(const std::string& path) {
-  return path == "<stdlib>" || path == "<TcUnit>" || path == "<FB_ASSERT>" || path == "<Tc2>";
+  return path == "<stdlib>" || path == "<TcUnit>" || path == "<FB_ASSERT>" || path == "<Tc2>" ||
+         path == "<Tc2_System>";
 }
 
 }  // namespace plcfi::st

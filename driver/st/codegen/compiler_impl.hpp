@@ -419,6 +419,7 @@ class Compiler {
   std::optional<Val> emit_temporal(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_advance_time(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_assert(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_system(const StdFunc& f, const CallExpr& c);
 
   // ---- side tables: the compiler's knowledge of the syntax tree, kept out of the program
   PouSource& src(const PouInfo* p) { return pou_src_[p]; }

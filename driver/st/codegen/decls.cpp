@@ -159,9 +159,14 @@ const Type* Compiler::named_type(const Ident& name, uint32_t file, bool report) 
   }
   if (report) {
     const auto& tc2 = tc2_types();
-    const bool is_tc2 = std::any_of(tc2.begin(), tc2.end(), [&](const Tc2Type& t) { return iequals(t.name, name.text); });
+    const auto& sys = tc2_system_items();
+    const bool is_tc2 = std::any_of(tc2.begin(), tc2.end(), [&](const Tc2Type& t) { return iequals(t.name, name.text); }) ||
+                        std::any_of(sys.begin(), sys.end(), [&](const Tc2Item& t) { return iequals(t.name, name.text); });
+    const char* lib = unprovided_library(name.text);
     diags_.error("ST201", name.loc, "unknown type '" + name.text + "'" +
-                                        (is_tc2 && opt_.dialect == Dialect::Iec ? " (a type of TwinCAT's Tc2 libraries: --dialect codesys)" : ""));
+                                        (is_tc2 && opt_.dialect == Dialect::Iec ? " (a type of TwinCAT's Tc2 libraries: --dialect codesys)"
+                                         : lib ? ": " + name.text + " is from " + std::string(lib) + ", which plcfi does not provide"
+                                               : std::string()));
   }
   return nullptr;
 }

@@ -276,7 +276,7 @@ class Translator {
         }
         if (op == Op::JMPB || n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) sm.loops = true;
         if (op == Op::ENTER) sm.methods = true;
-        if (!never_fails(op)) sm.fails = true;
+        if (!never_fails(op) || (op == Op::NATIVE && native_traps(code_[pc + 1] & 0xffffu))) sm.fails = true;
       }
       bool falls = !(last == Op::RET || last == Op::HALT || last == Op::JMP || last == Op::JMPB || last == Op::JTAB ||
                      last == Op::TRAP);
@@ -515,7 +515,9 @@ class Translator {
       case Op::SETMOCK: s = ptr("p", 1, "0", "8") + "mem[p + 2] = 1;"; return true;
       case Op::NATIVE:
         if (math_inline(w, &s)) return true;
-        s = fmt::format("c->native_fn(c, {}, base + {}, base + {}, base + {}, base + {});", K(1), K(2), K(3), K(4), K(5));
+        s = fmt::format("c->native_fn(c, {}u, {}, base + {}, base + {}, base + {}, base + {})", pc, K(1), K(2), K(3), K(4), K(5));
+        // The memory functions check their addresses and may trap; the rest never do.
+        s = native_traps(w[1] & 0xffffu) ? fmt::format("if ({}) {{ FLUSH(); BUDGET_OUT(); return kTrap; }}", s) : s + ";";
         return true;
       case Op::ASSERT: s = fmt::format("BUDGET_OUT(); if (c->assert_fn(c, {}u, base)) {{ FLUSH(); return kTrap; }}", pc); return true;
       case Op::SCPY:

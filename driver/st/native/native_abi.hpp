@@ -12,7 +12,7 @@ namespace plcfi::st::native_abi {
 
 constexpr int kOk = 0, kTrap = 1, kHalt = 2;
 constexpr uint32_t kMaxDepth = 256;  // as the interpreter's call stack
-constexpr uint32_t kAbiVersion = 1;
+constexpr uint32_t kAbiVersion = 2;  // 2: native_fn takes the pc and can trap
 
 struct Ctx {
   uint8_t* mem;
@@ -29,8 +29,10 @@ struct Ctx {
   int (*trap)(Ctx* c, uint32_t kind, uint32_t pc, int64_t a, int64_t b, int64_t cc);
   // Runs any entry (native or interpreted) as a call from the current frame.
   int (*call_entry)(Ctx* c, uint32_t entry, uint8_t* base);
-  // The NATIVE instruction (standard functions on strings etc.) and ASSERT.
-  void (*native_fn)(Ctx* c, uint32_t id, uint8_t* a, uint8_t* b, uint8_t* cc, uint8_t* d);
+  // The NATIVE instruction at pc (standard functions on strings etc.; kTrap when the
+  // function found a runtime error, recorded by the host: MEMCPY outside the memory) and
+  // ASSERT.
+  int (*native_fn)(Ctx* c, uint32_t pc, uint32_t id, uint8_t* a, uint8_t* b, uint8_t* cc, uint8_t* d);
   int (*assert_fn)(Ctx* c, uint32_t pc, uint8_t* base);
 };
 

@@ -40,6 +40,7 @@ enum class StdFamily : uint8_t {
   Temporal,       // RISING, CHANGES, PASSED, ... (temporal): requirement monitors only
   AdvanceTime,    // ADVANCE_TIME: test files only
   Assert,         // ASSERT_EQ, MOCK_VERIFY_CALLED, ... (assert_kind): test files only
+  System,         // Tc2_System's MEMCPY, ADSLOGSTR, ... (native, operands, result): codesys only
   Count_
 };
 
@@ -51,6 +52,7 @@ enum class Temporal : uint8_t { Rising, Falling, High, Low, Changes, Increases, 
 inline constexpr uint8_t kStdExtensible = 1;  // any number of arguments from min_args on
 inline constexpr uint8_t kStdLateOnly = 2;    // only in units compiled late (monitors); elsewhere unknown
 inline constexpr uint8_t kStdTestOnly = 4;    // only in TEST, SETUP and TEARDOWN blocks (error elsewhere)
+inline constexpr uint8_t kStdCodesysOnly = 8; // a vendor library's, under --dialect codesys; elsewhere unknown
 
 struct StdFunc {
   std::string_view name;  // canonical (upper case)
@@ -66,12 +68,17 @@ struct StdFunc {
   Pick pick = Pick::Min;             // Extremum
   Shift shift = Shift::Shl;          // Shift
   Temporal temporal = Temporal::Rising;  // Temporal
-  const char* operands = "";         // String: one letter per argument, S = string, I = integer
+  // String: one letter per argument, S = string, I = integer. System: A = an address
+  // (UDINT, a pointer or ADR(x)), U = UDINT, Y = USINT, W = DWORD, D = DINT, F = LREAL,
+  // S = STRING; `result` the same for the result.
+  const char* operands = "";
+  char result = 0;
   bool int_result = false;           // String: INT result (LEN, FIND) instead of a string
 
   bool extensible() const { return flags & kStdExtensible; }
   bool late_only() const { return flags & kStdLateOnly; }
   bool test_only() const { return flags & kStdTestOnly; }
+  bool codesys_only() const { return flags & kStdCodesysOnly; }
   // The largest argument count, SIZE_MAX when extensible.
   size_t max_count() const { return extensible() ? SIZE_MAX : max_args; }
 };

@@ -226,6 +226,89 @@ void bcd_encode(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) 
   store_as<uint64_t>(a, out);
 }
 
+// ---- Tc2_System: memory and the log
+
+// Whether n bytes at addr lie in the machine's memory; if not, the NATIVE instruction
+// traps with a message naming the function, and the caller touches nothing.
+bool in_memory(Machine& m, const char* fn, const char* what, uint32_t addr, uint32_t n) {
+  if (static_cast<uint64_t>(addr) + n <= m.mem_size()) return true;
+  m.native_trap(TrapKind::BadAddress,
+                fmt::format("{}: {} bytes at {} address 16#{:X} are outside the memory", fn, n, what, addr));
+  return false;
+}
+
+// Beckhoff's MEMCPY, MEMMOVE and MEMSET return the number of bytes, or 0 for a zero
+// address or count (the "incorrect parameter values" of the documentation), touching
+// nothing then. MEMCPY of overlapping areas is undefined there; here it moves, as MEMMOVE.
+void copy_bytes(Machine& m, const char* fn, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  const uint32_t dest = load_as<uint32_t>(b), src = load_as<uint32_t>(c), n = load_as<uint32_t>(d);
+  if (dest == 0 || src == 0 || n == 0) return store_as<uint32_t>(a, 0);
+  if (!in_memory(m, fn, "destination", dest, n) || !in_memory(m, fn, "source", src, n)) return store_as<uint32_t>(a, 0);
+  std::memmove(m.mem() + dest, m.mem() + src, n);
+  store_as<uint32_t>(a, n);
+}
+void mem_cpy(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) { copy_bytes(m, "MEMCPY", a, b, c, d); }
+void mem_move(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) { copy_bytes(m, "MEMMOVE", a, b, c, d); }
+void mem_set(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  const uint32_t dest = load_as<uint32_t>(b), n = load_as<uint32_t>(d);
+  if (dest == 0 || n == 0) return store_as<uint32_t>(a, 0);
+  if (!in_memory(m, "MEMSET", "destination", dest, n)) return store_as<uint32_t>(a, 0);
+  std::memset(m.mem() + dest, *c, n);
+  store_as<uint32_t>(a, n);
+}
+// -1, 0 or 1 by the first differing byte (unsigned), 16#FF for a zero address or count.
+void mem_cmp(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  const uint32_t p1 = load_as<uint32_t>(b), p2 = load_as<uint32_t>(c), n = load_as<uint32_t>(d);
+  if (p1 == 0 || p2 == 0 || n == 0) return store_as<int32_t>(a, 0xFF);
+  if (!in_memory(m, "MEMCMP", "pBuf1", p1, n) || !in_memory(m, "MEMCMP", "pBuf2", p2, n)) return store_as<int32_t>(a, 0);
+  int r = std::memcmp(m.mem() + p1, m.mem() + p2, n);
+  store_as<int32_t>(a, r < 0 ? -1 : (r > 0 ? 1 : 0));
+}
+
+constexpr size_t kMaxLogEntries = 10000;
+
+// The level of an ADSLOG control mask: error over warning over hint (ADSLOG_MSGTYPE_ERROR
+// 16#4, _WARN 16#2, _HINT 16#1); a mask with none of them is a hint, as the message box
+// of TwinCAT shows it.
+const char* log_level(uint32_t mask) { return mask & 0x4u ? "error" : mask & 0x2u ? "warn" : "hint"; }
+
+// The format string with its first placeholder (%s, %d or %f, the one the function takes)
+// replaced by the argument's text and "%%" by "%", as C's printf, which the runtime's
+// formatting follows, reads them. TwinCAT limits a message to 253 characters, and so
+// does this.
+void adslog(Machine& m, uint8_t* a, uint8_t* b, uint8_t* c, char conv, const std::string& arg) {
+  const std::string fmt_str = cs(c);
+  std::string out;
+  bool done = false;
+  for (size_t i = 0; i < fmt_str.size(); ++i) {
+    const char next = i + 1 < fmt_str.size() ? fmt_str[i + 1] : '\0';
+    if (fmt_str[i] == '%' && next == '%') {
+      out += '%';
+      ++i;
+    } else if (!done && fmt_str[i] == '%' && next == conv) {
+      out += arg;
+      done = true;
+      ++i;
+    } else {
+      out += fmt_str[i];
+    }
+  }
+  if (out.size() > 253) out.resize(253);
+  // A host that never takes the messages (a long campaign) keeps the first ones only,
+  // rather than memory growing with every scan.
+  if (m.log().size() < kMaxLogEntries) m.log().push_back({log_level(load_as<uint32_t>(b)), std::move(out)});
+  store_as<int32_t>(a, 0);
+}
+void adslog_str(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) { adslog(m, a, b, c, 's', cs(d)); }
+void adslog_dint(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  adslog(m, a, b, c, 'd', std::to_string(load_as<int32_t>(d)));
+}
+// Six decimals, as the documentation's example shows 187.203045.
+void adslog_lreal(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  adslog(m, a, b, c, 'f', fmt::format("{:.6f}", load_as<double>(d)));
+}
+void task_index(Machine& m, uint32_t, uint8_t* a, uint8_t*, uint8_t*, uint8_t*) { *a = m.task_index(); }
+
 struct Entry {
   NativeFn fn;
   const char* name;
@@ -244,6 +327,9 @@ constexpr Entry kNatives[] = {
     {dt_to_date, "DT_TO_DATE"}, {dt_to_tod, "DT_TO_TOD"},
     {bcd_decode, "BCD_DECODE"}, {bcd_encode, "BCD_ENCODE"},
     {array_difference, "ARRAY_DIFF"},
+    {mem_cpy, "MEMCPY"}, {mem_move, "MEMMOVE"}, {mem_set, "MEMSET"}, {mem_cmp, "MEMCMP"},
+    {adslog_str, "ADSLOGSTR"}, {adslog_dint, "ADSLOGDINT"}, {adslog_lreal, "ADSLOGLREAL"},
+    {task_index, "GETCURTASKINDEX"},
 };
 static_assert(sizeof(kNatives) / sizeof(kNatives[0]) == static_cast<size_t>(Native::Count_));
 

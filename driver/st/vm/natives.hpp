@@ -20,8 +20,21 @@ enum class Native : uint32_t {
   DT_TO_DATE, DT_TO_TOD,
   BCD_DECODE, BCD_ENCODE,  // a := f(b), both ULINT
   ARRAY_DIFF,              // a := the first difference of two arrays (vm.cpp: array_difference)
+  // Tc2_System (Beckhoff), on addresses (UDINT): a := MEMCPY(dest = b, src = c, n = d),
+  // MEMMOVE the same, MEMSET(dest = b, fill = c (USINT), n = d); a: UDINT. MEMCMP: a: DINT.
+  // An area outside the memory traps (Machine::native_trap) and touches nothing.
+  MEM_CPY, MEM_MOVE, MEM_SET, MEM_CMP,
+  // ADSLOGSTR, ADSLOGDINT, ADSLOGLREAL: a: DINT := 0; b: the DWORD mask; c: the format
+  // string; d: the argument (STRING, DINT, LREAL). The message goes to Machine::log().
+  ADSLOG_STR, ADSLOG_DINT, ADSLOG_LREAL,
+  TASK_INDEX,              // a: BYTE := the 1-based index of the running task
   Count_
 };
+
+// Whether the native can trap (the NATIVE instruction then checks for it).
+inline bool native_traps(uint32_t id) {
+  return id >= static_cast<uint32_t>(Native::MEM_CPY) && id <= static_cast<uint32_t>(Native::MEM_CMP);
+}
 
 // The literal text of a time-like value held in nanoseconds (TIME and LTIME durations,
 // DATE, TIME_OF_DAY and DATE_AND_TIME since 1970-01-01 / midnight): T#1h2m, D#2024-03-01,

@@ -127,6 +127,12 @@ bool Machine::fail(TrapKind k, const uint32_t* pc, std::string msg) {
   return false;
 }
 
+bool Machine::fail_native(const uint32_t* pc) {
+  TrapKind k = native_trap_kind_;
+  native_trap_kind_ = TrapKind::None;
+  return fail(k, pc, std::move(native_trap_msg_));
+}
+
 bool Machine::call(uint32_t entry, uint32_t base_addr) {
   trap_.kind = TrapKind::None;  // the message is only meaningful after a failed call
   if (entry >= app_->code.size() || base_addr > mem_.size())
@@ -188,8 +194,12 @@ struct NativeBridge {
     return ok ? native_abi::kOk : native_abi::kTrap;
   }
 
-  static void native_fn(native_abi::Ctx* c, uint32_t id, uint8_t* a, uint8_t* b, uint8_t* cc, uint8_t* d) {
-    native(id & 0xffffu)(m(c), id >> 16, a, b, cc, d);
+  static int native_fn(native_abi::Ctx* c, uint32_t pc, uint32_t id, uint8_t* a, uint8_t* b, uint8_t* cc, uint8_t* d) {
+    Machine& vm = m(c);
+    native(id & 0xffffu)(vm, id >> 16, a, b, cc, d);
+    if (vm.native_trap_kind_ == TrapKind::None) return native_abi::kOk;
+    vm.fail_native(vm.app_->code.data() + pc);
+    return native_abi::kTrap;
   }
 
   static int assert_fn(native_abi::Ctx* c, uint32_t pc, uint8_t* base) {
@@ -525,6 +535,7 @@ L_ADVTIME: now_ns_ += R(int64_t, 1); NEXT(1);
 L_SETMOCK: { PTR(p, 1, 0, 8); mem[p + 2] = 1; NEXT(1); }
 L_NATIVE:
   native(pc[1] & 0xffffu)(*this, pc[1] >> 16, base + pc[2], base + pc[3], base + pc[4], base + pc[5]);
+  if (native_trap_kind_ != TrapKind::None) [[unlikely]] return fail_native(pc);
   NEXT(5);
 L_ASSERT:
   if (!do_assert(pc, base)) return false;

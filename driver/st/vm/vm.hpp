@@ -76,6 +76,27 @@ class Machine {
 
   int64_t now() const { return now_ns_; }
   void set_now(int64_t ns) { now_ns_ = ns; }
+  // The 1-based index of the task whose programs run (GETCURTASKINDEX); the runtime sets
+  // it before each task, and it stays 1 where nothing sets it (tests, a single program).
+  uint8_t task_index() const { return task_index_; }
+  void set_task_index(uint8_t index) { task_index_ = index; }
+
+  // The messages the program logged (ADSLOGSTR and the like), in order, until the host
+  // takes them: level is "hint", "warn" or "error". Kept here, not printed, so a campaign
+  // or a test can decide where they go; `plcfi run` prints them to stderr.
+  struct LogEntry {
+    std::string level;
+    std::string text;
+  };
+  std::vector<LogEntry>& log() { return log_; }
+
+  // Called by a native helper that found a runtime error (MEMCPY outside the memory): the
+  // NATIVE instruction that called it then traps with this kind and message, at its own
+  // source location. The helper returns normally and must leave memory untouched.
+  void native_trap(TrapKind k, std::string msg) {
+    native_trap_kind_ = k;
+    native_trap_msg_ = std::move(msg);
+  }
   // Backward jumps and loop iterations allowed per call() before a Watchdog trap.
   void set_budget(uint64_t budget) { budget_limit_ = budget; }
 
@@ -114,6 +135,8 @@ class Machine {
   friend struct NativeBridge;
   bool restart(bool warm);
   bool fail(TrapKind k, const uint32_t* pc, std::string msg);
+  // The trap a native helper asked for (native_trap), at the NATIVE instruction pc.
+  bool fail_native(const uint32_t* pc);
   // Interprets from pc until the matching RET. mtop: the method stack top; budget: the
   // backward jumps left (read and, on a normal return, written back).
   bool run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget);
@@ -144,6 +167,10 @@ class Machine {
   std::vector<uint64_t> hits_;  // index = branch id; sized by set_count_hits(true)
   bool count_hits_ = false;
   int64_t now_ns_ = 0;
+  uint8_t task_index_ = 1;
+  std::vector<LogEntry> log_;
+  TrapKind native_trap_kind_ = TrapKind::None;
+  std::string native_trap_msg_;
   uint64_t budget_limit_ = 100'000'000;
   Trap trap_;
   std::string assert_message_;
