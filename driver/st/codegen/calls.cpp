@@ -204,6 +204,13 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
 // ------------------------------------------------------------------ functions
 
 namespace {
+// A positional argument after named ones takes the parameter declared after the last one
+// named (CODESYS: `fb(a := 1, 2)` gives 2 to the parameter after a).
+size_t next_position(const std::vector<Symbol*>& order, const Symbol* named, size_t pos) {
+  auto it = std::find(order.begin(), order.end(), named);
+  return it == order.end() ? pos : static_cast<size_t>(it - order.begin()) + 1;
+}
+
 // How many arguments a non-formal call must give: every parameter up to the last input or
 // in-out (outputs after it may be left out, their values then not captured).
 size_t non_formal_needed(const std::vector<Symbol*>& order) {
@@ -408,6 +415,8 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
   };
   std::vector<OutCapture> outs;
   std::vector<bool> given(params.size(), false);
+  std::vector<Symbol*> bound_syms;
+  bool named_before = false;
   for (const auto& a : c.args) {
     Symbol* p = nullptr;
     if (a.name) {
@@ -420,13 +429,21 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
         diags_.error("ST212", a.loc, f->name + " has no parameter '" + a.name->text + "'");
         continue;
       }
+      pos = next_position(order, p, pos);
+      named_before = true;
     } else {
+      if (named_before && !positional_after_named_ok(a.loc)) continue;
       if (pos >= order.size()) {
         diags_.error("ST210", a.loc, f->name + " takes " + std::to_string(order.size()) + " argument(s)");
         break;
       }
       p = order[pos++];
     }
+    if (std::find(bound_syms.begin(), bound_syms.end(), p) != bound_syms.end()) {
+      diags_.error("ST212", a.loc, "'" + p->name + "' of " + f->name + " is given twice");
+      continue;
+    }
+    bound_syms.push_back(p);
     if (a.is_output || p->section == VarSection::Output) {
       if (!a.is_output && a.name) {
         diags_.error("ST210", a.loc, "'" + p->name + "' is an output: capture it with '" + p->name + " => var'");
@@ -514,6 +531,8 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
   const std::vector<Symbol*> order = positional_params(fb);
   size_t pos = 0;
   std::vector<Symbol*> passed;
+  std::vector<Symbol*> bound_syms;
+  bool named_before = false;
   for (const auto& a : c.args) {
     Symbol* p = nullptr;
     if (a.name) {
@@ -522,13 +541,21 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
         diags_.error("ST212", a.loc, fb->name + " has no input or output '" + a.name->text + "'");
         continue;
       }
+      pos = next_position(order, p, pos);
+      named_before = true;
     } else {
+      if (named_before && !positional_after_named_ok(a.loc)) continue;
       if (pos >= order.size()) {
         diags_.error("ST210", a.loc, "too many arguments for " + fb->name);
         break;
       }
       p = order[pos++];
     }
+    if (std::find(bound_syms.begin(), bound_syms.end(), p) != bound_syms.end()) {
+      diags_.error("ST212", a.loc, "'" + p->name + "' of " + fb->name + " is given twice");
+      continue;
+    }
+    bound_syms.push_back(p);
     if (a.is_output || p->section == VarSection::Output) {
       if (!a.is_output && a.name) {
         diags_.error("ST210", a.loc, "'" + p->name + "' is an output of " + fb->name + ": write '" + p->name + " => var'");
@@ -685,6 +712,7 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
   for (Symbol* p : positional_params(m))
     if (!fixed_of(p)) by_position.push_back(p);
   size_t pos = 0;
+  bool named_before = false;
   for (const auto& a : args) {
     size_t idx = SIZE_MAX;
     if (a.name) {
@@ -699,9 +727,15 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
           if (iequals(o->name, a.name->text)) outs.emplace_back(o, &a);
         if (outs.empty() || outs.back().second != &a)
           diags_.error("ST212", a.loc, "method " + m->name + " has no parameter '" + a.name->text + "'");
+        else
+          pos = next_position(by_position, outs.back().first, pos);
+        named_before = true;
         continue;
       }
+      pos = next_position(by_position, params[idx], pos);
+      named_before = true;
     } else {
+      if (named_before && !positional_after_named_ok(a.loc)) continue;
       if (pos >= by_position.size()) {
         diags_.error("ST210", a.loc, "too many arguments for method " + m->name);
         break;
@@ -909,6 +943,18 @@ Val Compiler::query_interface(const CallExpr& c, bool pointer) {
   }
   bind(done);
   return load(result_place);
+}
+
+}  // namespace plcfi::st::detail
+
+namespace plcfi::st::detail {
+
+// IEC 61131-3 calls are formal or non-formal, never both; CODESYS takes a positional
+// argument after named ones (see next_position).
+bool Compiler::positional_after_named_ok(SourceLoc loc) {
+  if (opt_.dialect == Dialect::Codesys) return true;
+  diags_.error("ST241", loc, "a positional argument after named ones is CODESYS, not IEC 61131-3: name it, or use --dialect codesys");
+  return false;
 }
 
 }  // namespace plcfi::st::detail

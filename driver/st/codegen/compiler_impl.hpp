@@ -199,6 +199,7 @@ class Compiler {
   void layout_struct(Type* t, const std::vector<VarDecl>& members, uint32_t file);
   void declare_vars(PouInfo* p);
   void order_positional(PouInfo* p);
+  bool positional_after_named_ok(SourceLoc loc);
   std::vector<Symbol*> positional_params(const PouInfo* p) const;
   // The name under which a method's VAR_INST variable is kept in its owner's instance.
   static std::string inst_var_name(const PouInfo* method, const std::string& var);

@@ -590,6 +590,23 @@ Val Compiler::unary(const UnaryExpr& u, const Type* expected) {
   if (!t) return bad();
   Slot s = v.is_const ? to_slot(v, t, u.loc) : v.slot;
   Slot d = temp_for(t);
+  if (u.op == UnaryOp::Neg && opt_.dialect == Dialect::Codesys && (t->is_unsigned_int() || t->is_bitstring()) &&
+      t->kind != TypeKind::Bool) {
+    // CODESYS negates an unsigned value (OSCAT's `-step` with step : BYTE) in its wider
+    // signed arithmetic: the result is the negative number, in the next wider signed type.
+    const Type* wide = elem(t->size == 1 ? TypeKind::Int : t->size == 2 ? TypeKind::DInt : TypeKind::LInt);
+    if (opt_.warnings)
+      diags_.warning("ST405", u.loc, "implicit conversion from " + t->name + " to " + wide->name + " to negate it (" +
+                                         canon(t->name) + "_TO_" + canon(wide->name) + ")" +
+                                         (t->size == 8 ? ": values above LINT's range change" : ""));
+    Slot w = temp_for(wide);
+    emit(num_op(Op::NEG_I8, wide->storage()), {w, convert(s, t, wide)});
+    def(w);
+    Val out;
+    out.type = wide;
+    out.slot = w;
+    return out;
+  }
   if (u.op == UnaryOp::Neg) {
     if (!(t->is_numeric() || t->kind == TypeKind::Time || t->kind == TypeKind::LTime) || t->is_unsigned_int()) {
       diags_.error("ST204", u.loc, "'-' is not applicable to " + t->name);
@@ -670,6 +687,15 @@ Val Compiler::short_circuit(const BinaryExpr& e, const Val& l) {
   return v;
 }
 
+namespace {
+// Whether an integer value lies in an integer type's range (types of 1 to 4 bytes).
+bool int_fits(const Type* t, int64_t v) {
+  const int bits = static_cast<int>(t->size) * 8;
+  if (t->is_unsigned_int()) return v >= 0 && v < (int64_t{1} << bits);
+  return v >= -(int64_t{1} << (bits - 1)) && v < (int64_t{1} << (bits - 1));
+}
+}  // namespace
+
 Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   // The operator and where it stands (named time functions pass their call's location).
   const struct {
@@ -719,6 +745,23 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   const Type* lt = l.type ? l.type : nullptr;
   const Type* rt = r.type ? r.type : nullptr;
   if (lt && lt->kind == TypeKind::Enum && rt && rt->kind == TypeKind::Enum && lt != rt) return op_error();
+  // CODESYS computes integers in at least 32 bits: `x * 60000` with x an INT is done in
+  // DINT, where IEC 61131-3 types the literal as INT and it does not fit.
+  if (opt_.dialect == Dialect::Codesys && !is_logic(e.op)) {
+    const bool l_lit = !l.type && l.is_const && l.c.k == ConstV::K::Int;
+    const bool r_lit = !r.type && r.is_const && r.c.k == ConstV::K::Int;
+    const Type* other = l_lit ? rt : r_lit ? lt : nullptr;
+    const int64_t value = l_lit ? l.c.i : r.c.i;
+    if (other && other->is_integer() && other->size < 8 && !int_fits(other, value)) {
+      const Type* wide = elem(int_fits(elem(TypeKind::DInt), value) ? TypeKind::DInt : TypeKind::LInt);
+      if (opt_.warnings)
+        diags_.warning("ST405", e.loc, fmt::format("implicit conversion from {} to {}: the literal {} does not fit {}, so the "
+                                                   "operation is done in {} ({}_TO_{})",
+                                                   other->name, wide->name, value, other->name, wide->name, canon(other->name),
+                                                   canon(wide->name)));
+      (l_lit ? lt : rt) = wide;
+    }
+  }
   if (!lt) lt = (rt && (rt->is_numeric() || rt->is_bitstring())) ? rt : (rt && rt->is_time_like() ? elem(TypeKind::LInt) : default_type(l.c));
   if (!rt) rt = (lt->is_numeric() || lt->is_bitstring()) ? lt : (lt->is_time_like() ? elem(TypeKind::LInt) : default_type(r.c));
   if (l.is_const && !l.type && l.c.k == ConstV::K::Real && !lt->is_real()) lt = elem(TypeKind::LReal);
@@ -813,6 +856,22 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
       p.type = udint;  // the address, as the number it is
       Slot a = operand(p, udint), b = operand(n, udint);
       return emit_bin(e.op == BinaryOp::Add ? Op::ADD_I8 : Op::SUB_I8, udint, a, b, left ? lt : rt);
+    }
+  }
+  // CODESYS orders pointers as the addresses they are: with another pointer or a number.
+  if (opt_.dialect == Dialect::Codesys && is_cmp(e.op)) {
+    auto pointer = [&](const Type* t) { return t && t->kind == TypeKind::Ref && !t->implicit_deref; };
+    auto number = [&](const Val& v) { return v.type ? v.type->is_integer() || v.type->is_bitstring() : v.c.k == ConstV::K::Int; };
+    if ((pointer(lt) && (pointer(rt) || number(r))) || (pointer(rt) && number(l))) {
+      const Type* udint = elem(TypeKind::UDInt);
+      if (opt_.warnings && e.op != BinaryOp::Eq && e.op != BinaryOp::Ne)
+        diags_.warning("ST405", e.loc, std::string("pointer compared as an address (UDINT) with ") + op_text(e.op));
+      Val a = l, b = r;
+      if (pointer(lt)) a.type = udint;
+      if (pointer(rt)) b.type = udint;
+      Slot x = operand(a, udint), y = operand(b, udint);
+      static const Op kCmp[] = {Op::LT_I8, Op::GT_I8, Op::LE_I8, Op::GE_I8, Op::EQ_I8, Op::NE_I8};
+      return emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], udint, x, y, elem(TypeKind::Bool));
     }
   }
   // References and interfaces: equality only.

@@ -463,10 +463,15 @@ void Compiler::case_stmt(const CaseStmt& s) {
 void Compiler::for_stmt(const ForStmt& s) {
   Place var = place(*s.var, true);
   if (!var.ok) return;
-  if (var.k != Place::K::Frame || !var.type->is_integer() || var.readonly) {
-    diags_.error("ST220", s.var->loc, "the FOR control variable must be a local variable of an integer type");
+  if (!var.type->is_integer() || var.readonly) {
+    diags_.error("ST220", s.var->loc, "the FOR control variable must be a writable variable of an integer type");
     return;
   }
+  // A local is counted in place. Any other variable (a global, a VAR_IN_OUT, a member, an
+  // element: TwinCAT takes them) is counted in a temporary that is stored to it before each
+  // pass of the body and read back after it, so the body sees and may change the variable,
+  // and after the loop it holds the value that ended it.
+  const bool direct = var.k == Place::K::Frame;
   const Type* t = var.type->ranged ? elem(var.type->kind) : var.type;
   Val from = expr(*s.from, t);
   Val to = expr(*s.to, t);
@@ -486,7 +491,14 @@ void Compiler::for_stmt(const ForStmt& s) {
   Slot step = by.is_const ? konst(t, by.c, s.loc) : temp_for(t);
   if (!by.is_const) emit(mov_op(t->size), {step, by.slot});
   assign(var, from, s.loc);
-  Slot iv{var.off, var.sk};
+  Slot iv = direct ? Slot{var.off, var.sk} : temp_for(t);
+  auto read_back = [&] {
+    if (!direct) emit(mov_op(t->size), {iv, load(var).slot});
+  };
+  auto write_out = [&] {
+    if (!direct) store(var, iv);
+  };
+  read_back();
   Label body = new_label(), cont = new_label(), exit = new_label();
   bool down = by.is_const && by.c.i < 0;
   Storage st = t->storage();
@@ -498,11 +510,14 @@ void Compiler::for_stmt(const ForStmt& s) {
     uint32_t decision = kNoBranch;
     ArmScope in(b_, branch(s.loc, "FOR", s.loc, &decision, s.body));
     bind(body);
+    write_out();
     b_->loops.push_back({exit, cont});
     stmts(s.body);
     b_->loops.pop_back();
     bind(cont);
+    read_back();
     emit(int_op(down ? Op::LOOPDN_I8 : Op::LOOPUP_I8, st), {iv, step, limit, Arg::target(body.id)});
+    write_out();
     bind(exit);
     return;
   }
@@ -516,6 +531,7 @@ void Compiler::for_stmt(const ForStmt& s) {
   bind(up_test);
   emit(num_op(Op::JLT_I8, st), {Arg::target(exit.id), limit, iv});
   bind(body);
+  write_out();
   b_->loops.push_back({exit, cont});
   uint32_t decision = kNoBranch;
   {
@@ -524,7 +540,9 @@ void Compiler::for_stmt(const ForStmt& s) {
   }
   b_->loops.pop_back();
   bind(cont);
+  read_back();
   emit(num_op(Op::ADD_I8, st), {iv, iv, step});
+  write_out();
   emit(Op::JMPB, {Arg::target(top.id)});
   bind(exit);
 }

@@ -18,6 +18,10 @@ const std::vector<Tc2Type>& tc2_types() {
        "TYPE TIMESTRUCT :\nSTRUCT\n  wYear : WORD;\n  wMonth : WORD;\n  wDayOfWeek : WORD;\n  wDay : WORD;\n"
        "  wHour : WORD;\n  wMinute : WORD;\n  wSecond : WORD;\n  wMilliseconds : WORD;\nEND_STRUCT\nEND_TYPE\n"},
       {"T_FILETIME", "TYPE T_FILETIME :\nSTRUCT\n  dwLowDateTime : DWORD;\n  dwHighDateTime : DWORD;\nEND_STRUCT\nEND_TYPE\n"},
+      // Every library holds a global constant of this type with its version (stLibVersion_<lib>).
+      {"ST_LibVersion",
+       "TYPE ST_LibVersion :\nSTRUCT\n  iMajor : UINT;\n  iMinor : UINT;\n  iBuild : UINT;\n  iRevision : UINT;\n"
+       "  nFlags : DWORD;\n  sVersion : STRING(23);\nEND_STRUCT\nEND_TYPE\n"},
       {"UXINT", "TYPE UXINT : ULINT; END_TYPE\n"},
       {"XINT", "TYPE XINT : LINT; END_TYPE\n"},
       {"XWORD", "TYPE XWORD : LWORD; END_TYPE\n"},

@@ -281,7 +281,11 @@ StmtPtr Parser::parse_for() {
   {
     FrameGuard frame(*this, {Tok::EndFor, Tok::Eof, Tok::Eof}, true);
     Ident var;
-    if (expect_ident(&var, "ST122", "the FOR control variable")) {
+    if (at(Tok::Ident) && (la(1).kind == Tok::Dot || la(1).kind == Tok::LBracket || la(1).kind == Tok::Caret)) {
+      // `FOR st.nIndex := ...`, `FOR a[1] := ...`: TwinCAT takes any integer variable.
+      var = Ident{std::string(cur().text), cur().loc};
+      s->var = parse_postfix();
+    } else if (expect_ident(&var, "ST122", "the FOR control variable")) {
       auto n = std::make_unique<NameExpr>(var.loc);
       n->name = var;
       s->var = std::move(n);

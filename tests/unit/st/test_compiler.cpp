@@ -114,7 +114,7 @@ const SemaCase kCases[] = {
      1, "CASE label 3 appears twice"},
     {"for_variable_not_integer",
      "PROGRAM Main\nVAR r : REAL; k : INT; END_VAR\nFOR r := 1 TO 3 DO k := 2; END_FOR;\nEND_PROGRAM\n", "ST220", 3, 5,
-     "the FOR control variable must be a local variable of an integer type"},
+     "the FOR control variable must be a writable variable of an integer type"},
     {"for_step_zero", "PROGRAM Main\nVAR i, k : INT; END_VAR\nFOR i := 1 TO 3 BY 0 DO k := 2; END_FOR;\nEND_PROGRAM\n",
      "ST220", 3, 20, "FOR step must not be zero"},
     {"constant_index_out_of_range",
