@@ -629,6 +629,7 @@ Value Reference::eval(const st::Expr& e, Env& env) {
 Value Reference::unary(st::UnaryOp op, const Value& a) {
   Value v;
   v.t = a.t;
+  v.nominal = a.nominal;
   switch (op) {
     case st::UnaryOp::Plus:
       return a;
@@ -691,6 +692,42 @@ Value Reference::binary(st::BinaryOp op, const Value& a, const Value& b) {
     return v;
   }
   if (a.t->kind == VK::Date && a.t == b.t && is_cmp) return cmp(a.i < b.i ? -1 : a.i > b.i ? 1 : 0);
+  // CODESYS computes integers narrower than 32 bits in a 32-bit register (DINT, or UDINT
+  // when unsigned) and cuts them only when they are stored or converted.
+  // AND, OR and XOR cannot overflow: only an operand already in a register widens them.
+  const bool logic = op == B::And || op == B::Or || op == B::Xor;
+  if (codesys_ && a.t->kind == VK::Int && b.t->kind == VK::Int && (a.nominal || b.nominal || (!logic && !is_cmp))) {
+    const RType* an = a.nominal ? a.nominal : a.t;
+    const RType* bn = b.nominal ? b.nominal : b.t;
+    auto widens_to = [](const RType* from, const RType* to) {
+      return from == to || (from->bits < to->bits && (from->is_signed == to->is_signed || (!from->is_signed && to->is_signed)));
+    };
+    const RType* iec = widens_to(an, bn) ? bn : widens_to(bn, an) ? an : nullptr;
+    if (iec && iec->bits >= 32 && (a.nominal || b.nominal)) {  // a register met a 32/64-bit operand: its bits are read in that type
+      Value x = a, y = b;
+      x.i = norm(iec, static_cast<uint64_t>(x.i));
+      y.i = norm(iec, static_cast<uint64_t>(y.i));
+      x.t = y.t = iec;
+      x.nominal = y.nominal = nullptr;
+      return binary(op, x, y);
+    }
+    if (iec && iec->bits < 32 && is_cmp) {  // compared in the register
+      const RType* wide = a.nominal ? a.t : b.t;
+      Value x = a, y = b;
+      x.t = y.t = wide;
+      x.nominal = y.nominal = nullptr;
+      return binary(op, x, y);
+    }
+    if (iec && iec->bits < 32 && !is_cmp) {
+      const RType* wide = elementary(iec->is_signed ? "DINT" : "UDINT");
+      Value x = a, y = b;
+      x.t = y.t = wide;
+      x.nominal = y.nominal = nullptr;
+      Value out = binary(op, x, y);
+      out.nominal = iec;
+      return out;
+    }
+  }
   // Implicit widening of integers (SINT -> INT -> DINT -> LINT, USINT -> ... -> ULINT, an
   // unsigned type to a wider signed one): the narrower operand takes the wider type.
   if (a.t->kind == VK::Int && b.t->kind == VK::Int && a.t != b.t) {
@@ -1068,6 +1105,11 @@ Value Reference::standard(const std::string& name, const st::CallExpr& c, Env& e
   if (name == "SHL" || name == "SHR" || name == "ROL" || name == "ROR") {
     args(2, 2);
     v = a[0];
+    if (v.nominal && (name == "ROL" || name == "ROR")) {  // a rotation has its IEC type's width
+      v.i = norm(v.nominal, static_cast<uint64_t>(v.i));
+      v.t = v.nominal;
+      v.nominal = nullptr;
+    }
     if (v.t->kind != VK::Int) throw Unsupported(name + " of " + v.t->name);
     auto n = static_cast<uint64_t>(int_of(a[1]));
     auto w = static_cast<uint64_t>(v.t->bits);
@@ -1127,6 +1169,11 @@ Value Reference::standard(const std::string& name, const st::CallExpr& c, Env& e
     const RType* from = elementary(name.substr(0, at));
     if (!to || !from) throw Unsupported("conversion " + name);
     args(1, 1);
+    if (a[0].nominal == from) {  // a register value converted: cut to its IEC type first
+      a[0].i = norm(from, static_cast<uint64_t>(a[0].i));
+      a[0].t = from;
+      a[0].nominal = nullptr;
+    }
     if (a[0].t != from) throw Unsupported(name + " applied to " + a[0].t->name);
     return convert(a[0], to);
   }

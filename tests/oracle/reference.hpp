@@ -51,6 +51,9 @@ struct Value {
   std::shared_ptr<Instance> fb;    // Fb: the instance (owned where declared)
   Instance* ref = nullptr;         // Itf: the instance referred to, null when unassigned
   Value* ptr = nullptr;            // Ref: the variable referred to (storage never moves), or null
+  // --dialect codesys: an integer result held in a 32-bit register (t is DINT or UDINT),
+  // whose IEC type is this; a store cuts it to the target's width.
+  const RType* nominal = nullptr;
 };
 
 // Variables of one POU instance (or one call frame): by canonical name, with the

@@ -474,7 +474,25 @@ std::optional<Val> Compiler::emit_abs(const StdFunc& f, const CallExpr& c) {
   Slot d = temp_for(t);
   emit(num_op(Op::ABS_I8, t->storage()), {d, s});
   def(d);
-  return slot_val(t, d);
+  Val r = slot_val(t, d);
+  r.nominal = v.nominal;  // a register value stays one (Val::nominal)
+  return r;
+}
+
+// The IEC type of MIN/MAX/LIMIT/SEL/MUX over register values (Val::nominal): the common
+// type of the inputs' IEC types, when one of them is a register value and it is narrower
+// than the type `t` the selection is done in; else none.
+const Type* Compiler::register_nominal(const std::vector<Val>& vals, const Type* t) {
+  const Type* nom = nullptr;
+  bool any = false;
+  for (const Val& v : vals) {
+    if (!v.type) continue;
+    any = any || v.nominal;
+    const Type* vt = v.nominal ? v.nominal : v.type;
+    nom = nom ? common_type(*tt_, nom, vt) : vt;
+    if (!nom) return nullptr;
+  }
+  return any && nom && nom->size < t->size ? nom : nullptr;
 }
 
 std::optional<Val> Compiler::emit_extremum(const StdFunc& f, const CallExpr& c) {
@@ -507,7 +525,9 @@ std::optional<Val> Compiler::emit_extremum(const StdFunc& f, const CallExpr& c) 
     r = slots[0];
     for (size_t i = 1; i < slots.size(); ++i) r = op2(f.pick == Pick::Min ? Op::MIN_I8 : Op::MAX_I8, r, slots[i]);
   }
-  return slot_val(t, r);
+  Val out = slot_val(t, r);
+  out.nominal = register_nominal(vals, t);
+  return out;
 }
 
 // SEL and MUX: the inputs are evaluated and converted to their common type first, then
@@ -575,7 +595,9 @@ std::optional<Val> Compiler::emit_select(const StdFunc& f, const CallExpr& c) {
     emit(Op::TRAP, {static_cast<uint32_t>(TrapKind::IndexOutOfRange)});
   }
   bind(end);
-  return slot_val(t, d);
+  Val out = slot_val(t, d);
+  out.nominal = register_nominal(vals, t);
+  return out;
 }
 
 // Functional forms of the operators (ADD, GT, ...) and the named time functions: the
@@ -639,6 +661,11 @@ std::optional<Val> Compiler::emit_shift(const StdFunc& f, const CallExpr& c) {
     diags_.error("ST203", args[1]->loc, name + ": the shift count must be an integer");
     return bad();
   }
+  const bool rotate = f.shift == Shift::Rol || f.shift == Shift::Ror;
+  if (rotate && v.nominal) {  // a rotation has its IEC type's width: the register is cut first
+    v = coerce(v, v.nominal, args[0]->loc, name.c_str());
+    t = v.type;
+  }
   Slot a = to_slot(v, t, args[0]->loc);
   Slot b = n.is_const ? konst(elem(TypeKind::ULInt), n.c, args[1]->loc) : convert(n.slot, nt, elem(TypeKind::ULInt));
   Op base = f.shift == Shift::Shl   ? Op::SHL_I8
@@ -648,7 +675,9 @@ std::optional<Val> Compiler::emit_shift(const StdFunc& f, const CallExpr& c) {
   Slot d = temp_for(t);
   emit(int_op(base, t->storage()), {d, a, b});
   def(d);
-  return slot_val(t, d);
+  Val r = slot_val(t, d);
+  r.nominal = rotate ? nullptr : v.nominal;  // SHR(m - 4, 1) shifts the register and stays one
+  return r;
 }
 
 // ------------------------------------------------------------------ strings

@@ -86,6 +86,10 @@ struct Val {
   bool is_const = false;
   ConstV c;
   Slot slot;
+  // --dialect codesys: the IEC type of an integer result held wider, as CODESYS keeps
+  // intermediate results in (at least) 32-bit registers; `type` is the register's type.
+  // A store to the nominal type (or wider) converts without a warning.
+  const Type* nominal = nullptr;
 };
 
 // An lvalue.
@@ -273,6 +277,7 @@ class Compiler {
   Val expr(const Expr& e, const Type* expected = nullptr);
   Val binary(const BinaryExpr& e, const Type* expected);
   Val short_circuit(const BinaryExpr& e, const Val& l);
+  const Type* register_nominal(const std::vector<Val>& vals, const Type* t);
   Val combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc);
   Val unary(const UnaryExpr& e, const Type* expected);
   Val literal(const LiteralExpr& e, const Type* expected);

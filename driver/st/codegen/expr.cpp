@@ -100,6 +100,21 @@ const Type* Compiler::default_type(const ConstV& c) const {
 
 Val Compiler::coerce(const Val& v, const Type* to, SourceLoc loc, const char* what) {
   if (!v.ok || !to) return bad();
+  if (v.nominal && !v.is_const && v.type != to) {
+    // A register value (see Val::nominal): to its own type or wider it keeps every bit (as
+    // CODESYS's `dwVar := wVar + 1` gives 65536), to a narrower type it is cut, without a
+    // warning where its IEC type converts implicitly.
+    if (to->is_elementary() && (to == v.nominal || implicitly_converts(v.nominal, to) || implicitly_converts(v.type, to))) {
+      Val out;
+      out.type = to;
+      out.slot = convert(v.slot, v.type, to);
+      return out;
+    }
+    Val n;
+    n.type = v.nominal;
+    n.slot = convert(v.slot, v.type, v.nominal);
+    return coerce(n, to, loc, what);
+  }
   Val out = v;
   if (v.is_const && !v.type) {
     // Untyped literal: must be representable in the target.
@@ -625,6 +640,7 @@ Val Compiler::unary(const UnaryExpr& u, const Type* expected) {
   Val out;
   out.type = t->ranged ? elem(t->kind) : t;
   out.slot = d;
+  out.nominal = v.nominal;  // -(a + b) stays in the register
   return out;
 }
 
@@ -919,6 +935,32 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     return bad();
   }
   if (t->kind == TypeKind::Bool) t = elem(TypeKind::Byte);
+  // CODESYS computes integers in registers of at least 32 bits and cuts a result only when
+  // it is stored (or converted): `usi - 1 <> 255` is TRUE for usi = 0, `SHR(m - 4, 1)` shifts
+  // the 32-bit -1. An operation on narrower types is done in DINT (UDINT when unsigned) and
+  // its result remembers its IEC type (Val::nominal).
+  const Type* nominal = nullptr;
+  if (opt_.dialect == Dialect::Codesys && (t->is_integer() || t->is_bitstring())) {
+    // An untyped literal takes the IEC type of the other side (`b * 10 - 48` stays a BYTE).
+    const Type* ln = l.nominal ? l.nominal : (!l.type && l.is_const ? nullptr : lt);
+    const Type* rn = r.nominal ? r.nominal : (!r.type && r.is_const ? nullptr : rt);
+    if (!ln) ln = rn;
+    if (!rn) rn = ln;
+    const Type* iec = ln && rn ? common_type(*tt_, ln, rn) : nullptr;
+    if (!iec && ln && rn) iec = dialect_common_type(ln, rn);
+    // AND, OR and XOR cannot overflow: only an operand already in a register widens them.
+    const bool widen = !is_logic(e.op) || l.nominal || r.nominal;
+    if (iec && (iec->is_integer() || iec->is_bitstring()) && iec->size >= 4 && (l.nominal || r.nominal)) {
+      t = iec;  // a register met a 32/64-bit operand: its bits are read in that type
+    } else if (widen && !is_cmp(e.op) && iec && (iec->is_integer() || iec->is_bitstring()) && iec->size < 4) {
+      nominal = iec;
+      if (t->size < 4) t = elem(iec->is_unsigned_int() || iec->is_bitstring() ? TypeKind::UDInt : TypeKind::DInt);
+    }
+  }
+  auto in_register = [&](Val v) {
+    v.nominal = nominal;
+    return v;
+  };
   // Division by a constant (below) reads the divisor from its operands: no pool slot for it
   // (a FUNCTION copies its pool into its frame on every call).
   const bool by_const = (e.op == BinaryOp::Div || e.op == BinaryOp::Mod) && r.is_const && r.c.k == ConstV::K::Int &&
@@ -940,7 +982,7 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     Val v;
     v.type = t;
     v.slot = d;
-    return v;
+    return in_register(v);
   }
   if (e.op == BinaryOp::Pow) {
     const Type* rt2 = t->kind == TypeKind::Real ? t : elem(TypeKind::LReal);
@@ -960,13 +1002,13 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     Val v;
     v.type = t;
     v.slot = d;
-    return v;
+    return in_register(v);
   }
   switch (e.op) {
-    case BinaryOp::Add: return emit_bin(Op::ADD_I8, t, a, b, t);
-    case BinaryOp::Sub: return emit_bin(Op::SUB_I8, t, a, b, t);
-    case BinaryOp::Mul: return emit_bin(Op::MUL_I8, t, a, b, t);
-    case BinaryOp::Div: return emit_bin(Op::DIV_I8, t, a, b, t);
+    case BinaryOp::Add: return in_register(emit_bin(Op::ADD_I8, t, a, b, t));
+    case BinaryOp::Sub: return in_register(emit_bin(Op::SUB_I8, t, a, b, t));
+    case BinaryOp::Mul: return in_register(emit_bin(Op::MUL_I8, t, a, b, t));
+    case BinaryOp::Div: return in_register(emit_bin(Op::DIV_I8, t, a, b, t));
     case BinaryOp::Mod: {
       if (t->is_real()) return op_error();
       Slot d = temp_for(t);
@@ -979,7 +1021,7 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
       Val v;
       v.type = t;
       v.slot = d;
-      return v;
+      return in_register(v);
     }
     default: return op_error();
   }
