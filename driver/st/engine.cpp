@@ -9,6 +9,7 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -115,6 +116,76 @@ std::string tc2_system_library(const SourceManager& sm, const std::vector<uint32
   return text;
 }
 
+// After a parse error, the POUs that parsed are still type-checked, so that one broken
+// POU does not hide the errors of the others (a compiler would go on the same way). The
+// POUs holding a parse error are set aside for this pass, and a POU whose errors name one
+// of them (its errors follow from the broken one) is left out of the report. A parse
+// error outside every POU (a TYPE, a VAR_GLOBAL, a test) stops here: too much of what
+// the rest needs is missing to say anything reliable.
+void check_the_rest(Build& b, const CompileOptions& opt) {
+  auto before = [](SourceLoc a, SourceLoc c) { return std::tie(a.line, a.col) < std::tie(c.line, c.col); };
+  auto holds = [&](const Pou& p, SourceLoc l) {
+    return l.file == p.loc.file && !before(l, p.loc) && p.end_loc.valid() && !before(p.end_loc, l);
+  };
+  std::vector<SourceLoc> errors;
+  for (const Diagnostic& d : b.diags.all())
+    if (d.severity == Severity::Error) errors.push_back(d.loc);
+  if (errors.empty() || b.diags.error_count() > b.diags.all().size()) return;
+  struct SetAside {
+    CompilationUnit* unit;
+    size_t index;
+    PouPtr pou;
+  };
+  std::vector<SetAside> aside;
+  std::vector<std::string> broken;  // names of the POUs set aside, upper case
+  for (SourceLoc e : errors) {
+    bool found = false;
+    for (auto& u : b.units)
+      for (const auto& p : u->pous)
+        if (p && holds(*p, e)) found = true;
+    if (!found) return;
+  }
+  for (auto& u : b.units)
+    for (size_t i = u->pous.size(); i-- > 0;) {
+      const Pou& p = *u->pous[i];
+      if (std::none_of(errors.begin(), errors.end(), [&](SourceLoc e) { return holds(p, e); })) continue;
+      broken.push_back(canon(p.name.text));
+      aside.push_back({u.get(), i, std::move(u->pous[i])});
+      u->pous.erase(u->pous.begin() + static_cast<ptrdiff_t>(i));
+    }
+  DiagEngine rest(b.sm);
+  rest.set_warnings(false);
+  {
+    std::vector<const CompilationUnit*> units;
+    for (const auto& u : b.units) units.push_back(u.get());
+    std::vector<const TestFile*> tests;
+    for (const auto& t : b.tests) tests.push_back(t.get());
+    (void)compile(b.sm, units, tests, rest, opt);
+  }
+  // Put the broken POUs back where they were (reverse order of removal).
+  for (auto it = aside.rbegin(); it != aside.rend(); ++it)
+    it->unit->pous.insert(it->unit->pous.begin() + static_cast<ptrdiff_t>(it->index), std::move(it->pou));
+  auto names_broken = [&](const std::string& message) {
+    const std::string m = canon(message);
+    return std::any_of(broken.begin(), broken.end(), [&](const std::string& n) { return m.find("'" + n + "'") != std::string::npos; });
+  };
+  // The POU (by its position) each error of the second pass lies in; -1: none.
+  auto pou_of = [&](SourceLoc l) -> const Pou* {
+    for (const auto& u : b.units)
+      for (const auto& p : u->pous)
+        if (holds(*p, l)) return p.get();
+    return nullptr;
+  };
+  std::set<const Pou*> tainted;
+  for (const Diagnostic& d : rest.all())
+    if (d.severity == Severity::Error && names_broken(d.message)) tainted.insert(pou_of(d.loc));
+  for (const Diagnostic& d : rest.all()) {
+    if (d.severity != Severity::Error || names_broken(d.message) || tainted.count(pou_of(d.loc))) continue;
+    Diagnostic& copy = b.diags.error(d.code, d.loc, d.message);
+    copy.notes = d.notes;
+  }
+}
+
 std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> files, const CompileOptions& opt,
                               const GeneratedSources& late, const std::set<uint32_t>& imported = {}) {
   if (opt.dialect == Dialect::Codesys) {
@@ -128,6 +199,7 @@ std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> fi
     if (is_test_file(b->sm, f)) b->tests.push_back(parse_test_file(b->sm, f, b->diags));
     else b->units.push_back(parse_unit(b->sm, f, b->diags));
   }
+  if (b->diags.has_errors() && b->io_errors.empty()) check_the_rest(*b, opt);
   if (b->diags.has_errors() || !b->io_errors.empty()) return b;
   std::vector<const CompilationUnit*> units;
   for (const auto& u : b->units) units.push_back(u.get());
