@@ -235,6 +235,28 @@ Place Compiler::place_ref(const Expr& e, bool for_write) {
       const auto& ix = static_cast<const IndexExpr&>(e);
       Place base = place(*ix.base, for_write);
       if (!base.ok) return base;
+      if (opt_.dialect == Dialect::Codesys && base.type->kind == TypeKind::Ref && !base.type->implicit_deref &&
+          base.type->target && ix.indices.size() == 1) {
+        // CODESYS: p[i] of a POINTER TO T is the T at p + i * SIZEOF(T), a dereference
+        // (an address outside the PLC's memory traps as p^ does).
+        const Type* u32 = elem(TypeKind::UDInt);
+        Val pv = load(base);
+        Val i = expr(*ix.indices[0], elem(TypeKind::DInt));
+        if (!i.ok) return bad_place;
+        if (!(i.type ? i.type->is_integer() : i.c.k == ConstV::K::Int)) {
+          diags_.error("ST208", ix.indices[0]->loc, "a pointer's index must be an integer, not " + tname(i.type));
+          return bad_place;
+        }
+        Slot is = i.is_const ? konst_u32(static_cast<uint32_t>(i.c.i)) : convert(i.slot, i.type, u32);
+        Slot off = temp(4, 4), addr = temp(4, 4);
+        emit(num_op(Op::MUL_I8, u32->storage()), {off, is, konst_u32(base.type->target->size)});
+        emit(num_op(Op::ADD_I8, u32->storage()), {addr, pv.slot, off});
+        def(addr);
+        Val at;
+        at.type = base.type;
+        at.slot = addr;
+        return deref_place(at, base.type->target, e.loc);
+      }
       return index_place(base, ix);
     }
     case ExprKind::Deref: {
