@@ -616,18 +616,23 @@ void Compiler::declare_units(const std::vector<const CompilationUnit*>& all, siz
     }
   }
 
-  // Global constants are known by name before any declaration needs them (array bounds).
+  // Global constants are known by name before any declaration needs them (array bounds),
+  // also qualified by their list's name (`Params.MaxAxes`, as TwinCAT writes them).
   for (const auto* u : all) {
-    auto note = [&](const std::vector<VarBlock>& blocks) {
+    const std::string list = canon(std::filesystem::path(sm_.file(u->file).path).stem().string());
+    auto note = [&](const std::vector<VarBlock>& blocks, const std::string& scope) {
       for (const auto& blk : blocks)
         for (const auto& d : blk.decls)
           if (d.constant)
-            for (const auto& n : d.names) global_consts_[canon(n.text)] = {&d, u->file};
+            for (const auto& n : d.names) {
+              global_consts_[canon(n.text)] = {&d, u->file};
+              global_consts_[scope + "." + canon(n.text)] = {&d, u->file};
+            }
     };
-    note(u->globals);
+    note(u->globals, list);
     for (const auto& c : u->configs) {
-      note(c.globals);
-      for (const auto& r : c.resources) note(r.globals);
+      note(c.globals, canon(c.name.text));
+      for (const auto& r : c.resources) note(r.globals, canon(r.name.text));
     }
   }
 

@@ -522,9 +522,15 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
     }
     case ExprKind::Member: {
       bool reported = false;
-      if (auto ev = qualified_enum(static_cast<const MemberExpr&>(e), file, report, &reported))
+      const auto& m = static_cast<const MemberExpr&>(e);
+      if (auto ev = qualified_enum(m, file, report, &reported))
         return ConstV{ConstV::K::Int, ev->value, 0, {}};
       if (reported) return std::nullopt;
+      // A global constant qualified by its list's name: Params.MaxAxes.
+      if (m.base->kind == ExprKind::Name) {
+        auto it = global_consts_.find(canon(static_cast<const NameExpr&>(*m.base).name.text) + "." + canon(m.member.text));
+        if (it != global_consts_.end() && it->second.first->init) return const_eval(*it->second.first->init, it->second.second, report);
+      }
       return fail("a constant expression is required here");
     }
     case ExprKind::Name: {
