@@ -29,14 +29,15 @@ namespace plcfi::cli {
 namespace {
 
 // Compiles and prints diagnostics. Returns null after printing why.
-std::unique_ptr<st::Build> load(const std::vector<std::string>& files, const st::CompileOptions& opt, const char* cmd) {
+std::unique_ptr<st::Build> load(const std::vector<std::string>& files, const st::CompileOptions& opt, const char* cmd,
+                                size_t shown = st::DiagEngine::kShown) {
   if (files.empty()) {
     std::cerr << "plcfi " << cmd << ": no input files\n";
     return nullptr;
   }
   auto b = st::build_files(files, opt);
   for (const auto& e : b->io_errors) std::cerr << e << "\n";
-  std::cerr << b->diags.render_all();
+  std::cerr << b->diags.render_all(shown);
   return b;
 }
 
@@ -66,15 +67,17 @@ std::unique_ptr<st::NativeCode> load_native(const st::Application& app, const ch
 
 int cmd_check(const std::vector<std::string>& args) {
   po::options_description desc("plcfi check: compile ST files and report every error and warning");
-  desc.add_options()("no-warnings", "report errors only");
+  desc.add_options()("no-warnings", "report errors only")
+      ("max-shown", po::value<size_t>()->default_value(st::DiagEngine::kShown),
+       "show at most N diagnostics, errors first (0: all); the summary counts every one");
   po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi check FILES... [--no-warnings]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi check FILES... [--no-warnings] [--max-shown N]")) return 0;
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
   opt.warnings = !vm.count("no-warnings");
   opt.test_mode = true;  // test files may be checked too; their built-ins are then known
-  auto b = load(strings_of(vm, "files"), opt, "check");
+  auto b = load(strings_of(vm, "files"), opt, "check", vm["max-shown"].as<size_t>());
   if (!b) return 2;
   if (!b->io_errors.empty()) return 2;
   size_t errors = b->diags.error_count(), warnings = b->diags.warning_count();

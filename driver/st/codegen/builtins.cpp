@@ -204,12 +204,15 @@ std::vector<const Expr*> Compiler::positional(const CallExpr& c, size_t min, siz
         for (size_t i = 0; i < names->size(); ++i)
           if (iequals((*names)[i], a.name->text)) idx = i;
       if (a.name && idx == SIZE_MAX) {
-        // IN0, IN1, ... for the variadic functions.
+        // The extensible functions' inputs: IN1, IN2, ... (ADD, MAX, CONCAT, ...), or
+        // IN0, IN1, ... after MUX's K.
         std::string n = canon(a.name->text);
         bool after_k = names && names->size() && iequals((*names)[0], "K");  // MUX: K comes first
-        if (n.size() > 2 && n.rfind("IN", 0) == 0 && std::all_of(n.begin() + 2, n.end(), ::isdigit))
-          idx = static_cast<size_t>(std::stoul(n.substr(2))) + (after_k ? 1 : 0);
-        else if (n == "IN") idx = 0;
+        if (n.size() > 2 && n.size() < 6 && n.rfind("IN", 0) == 0 && std::all_of(n.begin() + 2, n.end(), ::isdigit)) {
+          size_t k = static_cast<size_t>(std::stoul(n.substr(2)));
+          if (after_k) idx = k + 1;
+          else if (k >= 1) idx = k - 1;
+        } else if (n == "IN") idx = 0;
       }
       if (idx == SIZE_MAX) {
         diags_.error("ST212", a.loc, std::string(name) + " has no parameter '" + (a.name ? a.name->text : "") + "'");

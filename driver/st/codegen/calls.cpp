@@ -60,11 +60,29 @@ bool Compiler::may_call(const Expr& root) const {
   return false;
 }
 
+namespace {
+// The implicit EN input / ENO output of a call, when the call names them.
+const CallArg* enable_arg(const CallExpr& c, bool eno) {
+  for (const auto& a : c.args)
+    if (a.name && a.is_output == eno && iequals(a.name->text, eno ? "ENO" : "EN")) return &a;
+  return nullptr;
+}
+}  // namespace
+
 // ------------------------------------------------------------------ dispatch
 
 Val Compiler::call(const CallExpr& c, bool as_statement) {
   mark(c.loc);
   const Expr& callee = *c.callee;
+  for (const CallArg* a : {enable_arg(c, false), enable_arg(c, true)}) {
+    const PouInfo* p = a ? callee_pou(callee) : nullptr;
+    if (a && !(p && p->find_var(a->is_output ? "ENO" : "EN"))) {
+      diags_.error("ST210", a->loc, std::string(a->is_output ? "ENO" : "EN") +
+                                        " on a call inside an expression: with EN FALSE the call has no value to give; "
+                                        "assign the call's value to a variable (r := F(EN := c, ...)) or make the call a statement");
+      return bad();
+    }
+  }
   auto void_val = [&]() {
     Val v;
     v.type = elem(TypeKind::Void);
@@ -199,6 +217,96 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
   (void)void_val;
   diags_.error("ST213", callee.loc, "this expression is not callable");
   return bad();
+}
+
+// ------------------------------------------------------------------ EN/ENO
+
+// The POU a call's callee names, where it is a user POU (function, FB instance, method);
+// null for the standard functions and what cannot be told without compiling.
+const PouInfo* Compiler::callee_pou(const Expr& callee) {
+  if (callee.kind == ExprKind::Name) {
+    const std::string key = canon(static_cast<const NameExpr&>(callee).name.text);
+    if (const Symbol* s = lookup(key)) return s->kind == SymKind::Var && s->type && s->type->kind == TypeKind::Pou ? s->type->pou : nullptr;
+    auto it = pous_.find(key);
+    return it == pous_.end() ? nullptr : it->second;
+  }
+  if (callee.kind == ExprKind::Member) {
+    const auto& m = static_cast<const MemberExpr&>(callee);
+    if (m.base->kind != ExprKind::Name) return nullptr;
+    const Symbol* s = lookup(canon(static_cast<const NameExpr&>(*m.base).name.text));
+    if (!s || s->kind != SymKind::Var || !s->type || s->type->kind != TypeKind::Pou || !s->type->pou) return nullptr;
+    if (const PouInfo* meth = s->type->pou->find_method(m.member.text)) return meth;
+    if (const Symbol* f = s->type->pou->find_var(m.member.text); f && f->type && f->type->kind == TypeKind::Pou) return f->type->pou;
+  }
+  return nullptr;
+}
+
+// IEC 61131-3's EN/ENO on a call written in ST: `F(EN := c, ..., ENO => ok)`. With EN
+// FALSE the POU does not run, its outputs are not captured and the variable its value is
+// assigned to keeps its value (as an FBD box's connected variable does; MATIEC writes the
+// result type's initial value instead); ENO is EN. A POU that declares EN or ENO itself
+// takes them as ordinary parameters. A call with EN nested inside an expression has no
+// variable to keep: an error, not a made-up value.
+bool Compiler::enabled_call(const CallExpr& c, const AssignStmt* assignment) {
+  const CallArg* en = enable_arg(c, false);
+  const CallArg* eno = enable_arg(c, true);
+  if (!en && !eno) return false;
+  if (const PouInfo* p = callee_pou(*c.callee)) {
+    if (en && p->find_var("EN")) en = nullptr;
+    if (eno && p->find_var("ENO")) eno = nullptr;
+    if (!en && !eno) return false;
+  }
+  const Type* boolean = elem(TypeKind::Bool);
+  Slot flag = temp(1, 1);
+  Place flag_place = frame_place(flag, boolean);
+  Val enabled;
+  enabled.type = boolean;
+  enabled.slot = flag;
+  if (en) {
+    Val v = en->value ? expr(*en->value, boolean) : bad();
+    if (!v.ok) return true;
+    if (!v.type || v.type->kind != TypeKind::Bool) {
+      diags_.error("ST204", en->value->loc, "EN needs a BOOL, not " + tname(v.type));
+      return true;
+    }
+    assign(flag_place, v, en->loc);
+  } else {
+    store(flag_place, konst(boolean, ConstV{ConstV::K::Bool, 1, 0, {}}, c.loc));
+  }
+  Label skip = new_label();
+  if (en) branch_on(enabled, c.loc, skip, false);
+  {
+    // The call proper, without EN and ENO: they are taken out of the argument list while
+    // it compiles and put back where they were (the tree is compiled more than once).
+    auto& args = const_cast<std::vector<CallArg>&>(c.args);
+    std::vector<std::pair<size_t, CallArg>> held;
+    for (size_t i = args.size(); i-- > 0;)
+      if (&args[i] == en || &args[i] == eno) {
+        held.emplace_back(i, std::move(args[i]));
+        args.erase(args.begin() + static_cast<std::ptrdiff_t>(i));
+      }
+    if (assignment) assign_stmt(*assignment);
+    else call(c, true);
+    for (auto it = held.rbegin(); it != held.rend(); ++it)
+      args.insert(args.begin() + static_cast<std::ptrdiff_t>(it->first), std::move(it->second));
+  }
+  bind(skip);
+  if (eno && eno->value) {
+    Place target = place(*eno->value, true);
+    if (!target.ok) return true;
+    if (target.type->kind != TypeKind::Bool) {
+      diags_.error("ST203", eno->value->loc, "ENO is a BOOL; " + tname(target.type) + " cannot take it");
+      return true;
+    }
+    Val out = enabled;
+    if (eno->negate) {
+      Slot n = temp(1, 1);
+      emit(Op::BNOT, {n, flag});
+      out.slot = n;
+    }
+    assign(target, out, eno->loc);
+  }
+  return true;
 }
 
 // ------------------------------------------------------------------ functions
@@ -337,6 +445,8 @@ const std::vector<std::pair<uint32_t, uint32_t>>& Compiler::written_first(PouInf
   for (const auto& st : decl->body) {
     if (st->kind == StmtKind::Assign) {
       const auto& a = static_cast<const AssignStmt&>(*st);
+      // `r := F(EN := c, ...)` leaves r as it was when c is FALSE: not a first write.
+      if (a.rhs->kind == ExprKind::Call && enable_arg(static_cast<const CallExpr&>(*a.rhs), false)) break;
       if (!a.is_ref_assign && !a.set_reset && a.lhs->kind == ExprKind::Name) {
         std::string key = canon(static_cast<const NameExpr&>(*a.lhs).name.text);
         if (!mentions(a.rhs.get(), &seen)) break;

@@ -338,6 +338,10 @@ class Compiler {
 
   // ---- calls of user code (calls.cpp)
   Val call(const CallExpr& c, bool as_statement);
+  // A call with EN/ENO (a statement, or the value of an assignment): IF EN THEN ... END_IF
+  // and ENO := EN. False when the call has no EN/ENO of the implicit kind.
+  bool enabled_call(const CallExpr& c, const AssignStmt* assignment);
+  const PouInfo* callee_pou(const Expr& callee);
   bool may_call(const Expr& e) const;
   Val call_function(PouInfo* f, const CallExpr& c);
   // The frame set-up of a FUNCTION call: the template's bytes this call needs (calls.cpp).

@@ -130,7 +130,9 @@ void Compiler::stmt(const Stmt& s) {
   mark(s.loc);
   switch (s.kind) {
     case StmtKind::Assign: assign_stmt(static_cast<const AssignStmt&>(s)); break;
-    case StmtKind::Call: call(*static_cast<const CallStmt&>(s).call, true); break;
+    case StmtKind::Call:
+      if (!enabled_call(*static_cast<const CallStmt&>(s).call, nullptr)) call(*static_cast<const CallStmt&>(s).call, true);
+      break;
     case StmtKind::If: if_stmt(static_cast<const IfStmt&>(s)); break;
     case StmtKind::Case: case_stmt(static_cast<const CaseStmt&>(s)); break;
     case StmtKind::For: for_stmt(static_cast<const ForStmt&>(s)); break;
@@ -232,6 +234,7 @@ void Compiler::assign_stmt(const AssignStmt& s) {
     bind(skip);
     return;
   }
+  if (s.rhs->kind == ExprKind::Call && enabled_call(static_cast<const CallExpr&>(*s.rhs), &s)) return;
   // Warn about x := x, a typing accident more often than intent.
   if (opt_.warnings && s.lhs->kind == ExprKind::Name && s.rhs->kind == ExprKind::Name &&
       iequals(static_cast<const NameExpr&>(*s.lhs).name.text, static_cast<const NameExpr&>(*s.rhs).name.text))

@@ -68,18 +68,33 @@ std::string DiagEngine::render(const Diagnostic& d) const {
   return out;
 }
 
-std::string DiagEngine::render_all() const {
+std::string DiagEngine::render_all(size_t limit) const {
+  // Errors are what a user must fix: they are shown before warnings fill the screen.
+  std::vector<const Diagnostic*> order;
+  for (const auto& d : diags_)
+    if (d.severity == Severity::Error && (limit == 0 || order.size() < limit)) order.push_back(&d);
+  for (const auto& d : diags_)
+    if (d.severity != Severity::Error && (limit == 0 || order.size() < limit)) order.push_back(&d);
   // Source order, whichever stage found a problem first (declarations are checked
   // after bodies start compiling, so collection order is not reading order).
-  std::vector<const Diagnostic*> order;
-  for (const auto& d : diags_) order.push_back(&d);
   std::stable_sort(order.begin(), order.end(), [](const Diagnostic* a, const Diagnostic* b) {
     return std::tie(a->loc.file, a->loc.line, a->loc.col) < std::tie(b->loc.file, b->loc.line, b->loc.col);
   });
   std::string out;
-  for (const Diagnostic* d : order) out += render(*d);
-  if (errors_ + warnings_ > diags_.size())
-    out += "(" + std::to_string(errors_ + warnings_ - diags_.size()) + " further diagnostics not shown)\n";
+  size_t errors_shown = 0, warnings_shown = 0;
+  for (const Diagnostic* d : order) {
+    out += render(*d);
+    ++(d->severity == Severity::Error ? errors_shown : warnings_shown);
+  }
+  size_t more_errors = errors_ - std::min(errors_, errors_shown);
+  size_t more_warnings = warnings_ - std::min(warnings_, warnings_shown);
+  if (more_errors || more_warnings) {
+    std::string what;
+    if (more_errors) what = std::to_string(more_errors) + (more_errors == 1 ? " more error" : " more errors");
+    if (more_warnings)
+      what += (what.empty() ? "" : " and ") + std::to_string(more_warnings) + (more_warnings == 1 ? " more warning" : " more warnings");
+    out += "(" + what + " not shown" + (limit && diags_.size() > order.size() ? "; `plcfi check --max-shown 0` shows them all" : "") + ")\n";
+  }
   return out;
 }
 

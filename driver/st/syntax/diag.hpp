@@ -39,11 +39,15 @@ class DiagEngine {
   size_t warning_count() const { return warnings_; }
   bool has_errors() const { return errors_ != 0; }
   // Caps runaway output on garbage input; further errors are counted but not stored.
-  static constexpr size_t kMaxStored = 500;
+  static constexpr size_t kMaxStored = 10000;
+  // How many render_all shows unless told otherwise: a screenful a user reads.
+  static constexpr size_t kShown = 50;
 
   // Renders one diagnostic with its source line and caret.
   std::string render(const Diagnostic& d) const;
-  std::string render_all() const;
+  // Every stored diagnostic in source order, at most `limit` of them (0: all): errors
+  // first, warnings fill what is left; a last line counts those not shown.
+  std::string render_all(size_t limit = kShown) const;
 
  private:
   Diagnostic& report(Severity sev, std::string code, SourceLoc loc, std::string message);
