@@ -307,6 +307,7 @@ void Compiler::compile_pou(PouInfo* p) {
     emit(Op::JNE_I64, {Arg::target(shift.id), Slot{state_in->offset, SK::Var}, seen});
     bind(body_start);
   }
+  if (p->kind == PouKind::Function || p->kind == PouKind::Method) emit_runtime_inits(runtime_inits(p));
   if (decl) stmts(decl->body);
   mark(decl ? decl->end_loc : SourceLoc{});
   emit(Op::RET, {});
@@ -390,7 +391,8 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   if (p->type_id) put<uint16_t>(image.data(), static_cast<uint16_t>(p->type_id));
   for (const auto& v : p->vars) {
     const VarDecl* vd = decl_of(v.get());
-    if (v->where == Where::Frame) write_init(image, v->offset, v->type, vd ? vd->init.get() : nullptr, p->file);
+    const bool at_run_time = std::find(runtime_inits(p).begin(), runtime_inits(p).end(), v.get()) != runtime_inits(p).end();
+    if (v->where == Where::Frame) write_init(image, v->offset, v->type, vd && !at_run_time ? vd->init.get() : nullptr, p->file);
   }
   std::copy(b.consts.begin(), b.consts.end(), image.begin() + const_base);
 

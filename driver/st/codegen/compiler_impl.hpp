@@ -366,6 +366,13 @@ class Compiler {
   bool lifecycle_needed(const Type* t, bool exit);
   // Whether the instances p holds (its own variables and its base FB's) need it.
   bool members_need(PouInfo* p, bool exit);
+  // CODESYS computes an initial value that is not a constant expression (other variables,
+  // ADR(x)) when the variable is initialised, in declaration order: an FB's or PROGRAM's
+  // in its init entry (before the FB_init of what it holds), a FUNCTION's or METHOD's on
+  // every call, a global's in the application's init routine. Warning ST407 names each.
+  bool runtime_init(const Symbol* v, const VarDecl* d, uint32_t file, bool report);
+  const std::vector<const Symbol*>& runtime_inits(PouInfo* p);
+  void emit_runtime_inits(const std::vector<const Symbol*>& vars);
   // Calls the init or exit entry of pou on the instance at `at` (a frame or global place).
   void call_entry(const Place& at, PouInfo* pou, EntryKind which);
   // FB_init (FB_exit) of the instance at `at` of type t and of all it holds; d: its
@@ -476,6 +483,8 @@ class Compiler {
   const Type* null_type_ = nullptr;
   const PouInfo* decl_pou_ = nullptr;  // POU whose declarations are being laid out
   std::unordered_map<std::string, std::pair<const VarDecl*, uint32_t>> global_consts_;
+  std::unordered_map<const PouInfo*, std::vector<const Symbol*>> runtime_inits_;
+  std::vector<const Symbol*> global_runtime_inits_;  // declaration order
   std::vector<std::unique_ptr<Body>> bodies_;  // finished bodies waiting for final layout
   std::vector<std::pair<Body*, std::vector<uint32_t>*>> pending_;
   Body* b_ = nullptr;  // body being compiled

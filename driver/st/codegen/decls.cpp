@@ -874,7 +874,9 @@ void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::s
         } else {
           s->where = Where::Abs;
           s->offset = alloc(t->size, t->align);
-          write_init(app_->init_image, s->offset, t, d.init.get(), file);
+          const bool at_run_time = runtime_init(s.get(), &d, file, true);
+          if (at_run_time) global_runtime_inits_.push_back(s.get());
+          write_init(app_->init_image, s->offset, t, at_run_time ? nullptr : d.init.get(), file);
           if (d.retain) app_->retain_ranges.emplace_back(s->offset, t->size);
         }
         globals_[key] = s.get();

@@ -72,9 +72,50 @@ bool Compiler::lifecycle_needed(const Type* t, bool exit) {
   return need;
 }
 
+bool Compiler::runtime_init(const Symbol* v, const VarDecl* d, uint32_t file, bool report) {
+  // RETAIN variables keep their value over a warm restart: their initial value stays a constant.
+  if (opt_.dialect != Dialect::Codesys || !d || !d->init || !v || !v->type || v->constant || v->retain) return false;
+  const Expr& init = *d->init;
+  if (init.kind == ExprKind::ArrayInit || init.kind == ExprKind::StructInit) return false;
+  if (!v->type->is_elementary() && !v->type->is_string()) return false;
+  if (v->section == VarSection::InOut || v->section == VarSection::External) return false;
+  if (v->type->kind == TypeKind::Enum && init.kind == ExprKind::Name) return false;  // a value of the type
+  if (const_eval(init, file, false)) return false;
+  if (report)
+    diags_.warning("ST407", init.loc, "the initial value of '" + v->name +
+                                         "' is not a constant expression: computed when the variable is initialised, "
+                                         "in declaration order (CODESYS)");
+  return true;
+}
+
+const std::vector<const Symbol*>& Compiler::runtime_inits(PouInfo* p) {
+  auto found = runtime_inits_.find(p);
+  if (found != runtime_inits_.end()) return found->second;
+  auto& out = runtime_inits_[p];
+  // A FUNCTION's inputs take their defaults where a call leaves them out: constants only.
+  for (const auto& v : p->vars)
+    if (v->where == Where::Frame && !(p->kind == PouKind::Function && v->section == VarSection::Input) &&
+        runtime_init(v.get(), decl_of(v.get()), p->file, true))
+      out.push_back(v.get());
+  return out;
+}
+
+void Compiler::emit_runtime_inits(const std::vector<const Symbol*>& vars) {
+  for (const Symbol* v : vars) {
+    const VarDecl* d = decl_of(v);
+    mark(d->init->loc);
+    Place dst = symbol_place(v, d->init->loc);
+    dst.readonly = false;  // initialising, not assigning
+    Val val = expr_for(*d->init, v->type);
+    if (!dst.ok || !val.ok) continue;
+    assign(dst, val, d->init->loc);
+  }
+}
+
 bool Compiler::members_need(PouInfo* p, bool exit) {
   if (opt_.dialect != Dialect::Codesys || is_late(p)) return false;
   if (p->base && members_need(p->base, exit)) return true;
+  if (!exit && !runtime_inits(p).empty()) return true;
   for (const auto& v : p->vars)
     if (v->where == Where::Frame && v->section != VarSection::Temp && lifecycle_needed(v->type, exit)) return true;
   return false;
@@ -147,6 +188,7 @@ void Compiler::lifecycle_entries(PouInfo* p, std::vector<uint32_t>* entries, siz
     const bool base_too = p->base && members_need(p->base, exit);
     // The base's part of the instance is at offset 0: its entry runs on this instance.
     if (base_too && !exit) emit(Op::CALL, {Slot{0, SK::Var}, Arg::entry(p->base, EntryKind::Init)});
+    if (!exit) emit_runtime_inits(runtime_inits(p));
     for (const Symbol* v : held) {
       mark(v->loc);
       instance_lifecycle(symbol_place(v, v->loc), v->type, decl_of(v), exit, v->loc);
@@ -174,12 +216,20 @@ void Compiler::compile_lifecycle() {
   };
   for (const auto& pi : app_->programs)
     if (pi.pou->compiled) roots.push_back({abs(pi.addr, pi.pou->type), pi.pou->type, nullptr, pi.pou->loc});
+  // A PROGRAM that only a test names (Main.x in a TEST) has an instance of its own.
+  std::vector<std::pair<uint32_t, const PouInfo*>> named_only;
+  for (const auto& [p, at] : program_addr_)
+    if (std::none_of(app_->programs.begin(), app_->programs.end(), [&, addr = at.first](const ProgramInstance& pi) { return pi.addr == addr; }))
+      named_only.emplace_back(at.first, p);
+  std::sort(named_only.begin(), named_only.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [addr, p] : named_only) roots.push_back({abs(addr, p->type), p->type, nullptr, p->loc});
   for (const auto& g : app_->globals)
     if (g.sym->where == Where::Abs) roots.push_back({abs(g.sym->offset, g.sym->type), g.sym->type, decl_of(g.sym), g.sym->loc});
   for (const auto& p : app_->pous)  // VAR_STAT: one per POU, like a global
     for (const auto& v : p->vars)
       if (v->section == VarSection::Stat && v->where == Where::Abs) roots.push_back({abs(v->offset, v->type), v->type, nullptr, v->loc});
-  const bool any_init = std::any_of(roots.begin(), roots.end(), [&](const Root& r) { return lifecycle_needed(r.type, false); });
+  const bool any_init = !global_runtime_inits_.empty() ||
+                        std::any_of(roots.begin(), roots.end(), [&](const Root& r) { return lifecycle_needed(r.type, false); });
   const bool any_exit = std::any_of(roots.begin(), roots.end(), [&](const Root& r) { return lifecycle_needed(r.type, true); });
   if (!any_init && !any_exit) return;
 
@@ -201,6 +251,10 @@ void Compiler::compile_lifecycle() {
   for (bool exit : {false, true}) {
     entries.push_back(static_cast<uint32_t>(b_->code.size()));
     if (exit) std::reverse(roots.begin(), roots.end());
+    for (const Symbol* g : exit ? std::vector<const Symbol*>{} : global_runtime_inits_) {
+      file_ = g->loc.file;
+      emit_runtime_inits({g});
+    }
     for (const Root& r : roots) {
       if (!lifecycle_needed(r.type, exit)) continue;
       mark(r.loc);
