@@ -108,21 +108,34 @@ inline bool parse_args(const std::vector<std::string>& args, boost::program_opti
   return true;
 }
 
-// --dialect and --strict, on every command that reads ST.
+// --dialect, --strict and --library, on every command that reads ST.
 inline void add_dialect_options(boost::program_options::options_description& desc) {
   desc.add_options()
       ("dialect", boost::program_options::value<std::string>()->default_value("iec"),
        "ST dialect: iec (IEC 61131-3) or codesys (CODESYS and TwinCAT 3: implicit conversions as warnings, ...)")
-      ("strict", "with --dialect codesys: the dialect's implicit conversions are errors");
+      ("strict", "with --dialect codesys: the dialect's implicit conversions are errors")
+      ("library", boost::program_options::value<std::vector<std::string>>()->value_name("DIR"),
+       "a library as sources: the .plcproj under DIR, else every .st, TwinCAT object (.TcPOU, ...) and "
+       "PLCopen .xml under it; its POUs, types and globals are the program's to use (repeatable)");
 }
-// The dialect options into `opt`; a dialect that does not exist is a usage error.
-// Without --dialect, TwinCAT project files are read as what they are: CODESYS ST.
+// The dialect and library options into `opt`; a dialect that does not exist, or a
+// library folder that does not exist or holds no sources, is a usage error.
+// Without --dialect, TwinCAT project files (the program's or a library's) are read as
+// what they are: CODESYS ST.
 inline void apply_dialect_options(const boost::program_options::variables_map& vm, st::CompileOptions* opt) {
   const std::string& d = vm["dialect"].as<std::string>();
   if (!st::parse_dialect(d, &opt->dialect))
     throw boost::program_options::error("--dialect must be iec or codesys, not '" + d + "'");
-  if (vm["dialect"].defaulted() && vm.count("files"))
-    for (const auto& f : vm["files"].as<std::vector<std::string>>())
+  if (vm.count("library"))
+    for (const auto& dir : vm["library"].as<std::vector<std::string>>()) {
+      std::string err;
+      if (!st::library_sources(dir, &opt->library_files, &err)) throw boost::program_options::error(err);
+    }
+  std::vector<std::string> inputs = opt->library_files;
+  if (vm.count("files"))
+    for (const auto& f : vm["files"].as<std::vector<std::string>>()) inputs.push_back(f);
+  if (vm["dialect"].defaulted())
+    for (const auto& f : inputs)
       if (st::input_kind(f) == st::InputKind::TwinCat) opt->dialect = st::Dialect::Codesys;
   opt->strict = vm.count("strict") != 0;
 }

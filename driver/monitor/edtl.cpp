@@ -578,8 +578,10 @@ bool check_trace(const RequirementsFile& reqs, const std::string& trace_path, in
   uint64_t state = 0;
   error->clear();
   while (reader->next(&t, &values, error)) {
+    const std::vector<int64_t>& times = reader->time_values();
     for (size_t i = 0; i < handles.size(); ++i) {
       if (handles[i].type->is_real()) st::write_real(m, handles[i], values[i]);
+      else if (i < times.size() && reader->columns()[i].is_time()) st::write_int(m, handles[i], times[i]);
       else st::write_int(m, handles[i], static_cast<int64_t>(values[i]));
     }
     m.set_now(t);

@@ -19,6 +19,8 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "syntax/lexer.hpp"
+
 namespace plcfi::monitor {
 
 namespace {
@@ -173,6 +175,57 @@ bool parse_number(std::string_view s, double* v, std::string* scratch) {
   return end == scratch->c_str() + scratch->size() && std::isfinite(*v);
 }
 
+// Whether a cell is written as a typed literal (a prefix, then '#'): T#1s, DT#..., ...
+bool looks_like_literal(std::string_view s) {
+  size_t hash = s.find('#');
+  return hash != std::string_view::npos && hash > 0 && std::isalpha(static_cast<unsigned char>(s[0]));
+}
+
+// A TIME, LTIME, DATE, TOD or DT literal (any spelling of the prefix ST takes) read by
+// the ST lexer itself, so that a trace takes exactly what a program takes: its value in
+// nanoseconds and its column kind. False with *why (empty for a literal of another
+// type) and the 0-based offset of the trouble in *at otherwise.
+bool parse_time_literal(std::string_view s, int64_t* ns, TraceColumn::Kind* kind, std::string* why, size_t* at) {
+  st::SourceManager sm;
+  const uint32_t f = sm.add("<cell>", std::string(s));
+  st::DiagEngine diags(sm);
+  std::vector<st::Token> toks = st::lex_file(sm, f, diags);
+  for (const auto& d : diags.all())
+    if (d.severity == st::Severity::Error) {
+      // The lexer names the literal first ("T#1s5: missing ..."); the message names it already.
+      *why = d.message.rfind(std::string(s) + ": ", 0) == 0 ? d.message.substr(s.size() + 2) : d.message;
+      *at = d.loc.col > 0 ? d.loc.col - 1 : 0;
+      return false;
+    }
+  *at = 0;
+  if (toks.empty() || toks[0].kind != st::Tok::TimeLit) {
+    why->clear();  // a literal of another type (INT#5): the message says enough
+    return false;
+  }
+  if (toks.size() > 1 && toks[1].kind != st::Tok::Eof) {
+    *why = "unexpected text after the literal";
+    *at = toks[1].offset;
+    return false;
+  }
+  switch (toks[0].lit) {
+    case st::LiteralKind::Date: *kind = TraceColumn::Kind::Date; break;
+    case st::LiteralKind::TimeOfDay: *kind = TraceColumn::Kind::Tod; break;
+    case st::LiteralKind::DateTime: *kind = TraceColumn::Kind::Dt; break;
+    default: *kind = TraceColumn::Kind::Time; break;
+  }
+  *ns = toks[0].time_ns;
+  return true;
+}
+
+const char* time_kind_name(TraceColumn::Kind k) {
+  switch (k) {
+    case TraceColumn::Kind::Date: return "DATE";
+    case TraceColumn::Kind::Tod: return "TOD";
+    case TraceColumn::Kind::Dt: return "DT";
+    default: return "TIME";
+  }
+}
+
 class CsvReader final : public TraceReader {
  public:
   bool init(std::string name, std::unique_ptr<std::istream> in, int64_t cycle_ns, std::string* err) {
@@ -212,20 +265,26 @@ class CsvReader final : public TraceReader {
       return false;
     }
     // First pass: every row is checked, and each column gets its kind (BOOL when only
-    // 0/1, integer, else real) before the monitors are compiled against the columns.
+    // 0/1, integer, else real; the literals' type when it holds TIME, DATE, TOD or DT
+    // literals) before the monitors are compiled against the columns.
     std::string_view line;
     int64_t t;
+    first_pass_ = true;
     while (lines_->next(&line, err)) {
       if (line.empty()) continue;
       if (!parse_row(line, &t, &values_, err)) return false;
       for (size_t c = 0; c < columns_.size(); ++c) {
         double v = values_[c];
         auto& k = columns_[c].kind;
+        if (k >= TraceColumn::Kind::Time) continue;
         if (v != std::floor(v)) k = TraceColumn::Kind::Real;
         else if (k == TraceColumn::Kind::Bool && v != 0 && v != 1) k = TraceColumn::Kind::Int;
       }
     }
     if (!err->empty()) return false;
+    first_pass_ = false;
+    for (const auto& c : columns_)
+      if (c.is_time()) time_values_.assign(columns_.size(), 0);
     if (!lines_->rewind() || !lines_->next(&line, err)) {
       if (err->empty()) *err = name_ + ": cannot read the trace a second time";
       return false;
@@ -276,10 +335,41 @@ class CsvReader final : public TraceReader {
     values->resize(columns_.size());
     for (size_t c = 0; c < columns_.size(); ++c) {
       const Cell& cell = cells_[c + off];
+      if (looks_like_literal(cell.text)) {
+        int64_t ns = 0;
+        TraceColumn::Kind kind{};
+        std::string why;
+        size_t at = 0;
+        if (!parse_time_literal(cell.text, &ns, &kind, &why, &at)) {
+          *err = where(name_, line_no, cell.col + at) + "'" + std::string(cell.text) + "' in column " + columns_[c].name +
+                 " is not a number or a TIME, DATE, TOD or DT literal" + (why.empty() ? "" : ": " + why);
+          return false;
+        }
+        if (first_pass_) {
+          // A column holds one type: the kind of its first literal.
+          auto& k = columns_[c].kind;
+          if (!columns_[c].is_time()) k = kind;
+          else if (k != kind) {
+            *err = where(name_, line_no, cell.col) + "'" + std::string(cell.text) + "' in column " + columns_[c].name +
+                   " is a " + time_kind_name(kind) + " literal; the column's earlier literals are " + time_kind_name(k);
+            return false;
+          }
+        }
+        (*values)[c] = static_cast<double>(ns);
+        if (!time_values_.empty()) time_values_[c] = ns;
+        continue;
+      }
       if (!parse_number(cell.text, &(*values)[c], &scratch_)) {
         *err = where(name_, line_no, cell.col) + "'" + std::string(cell.text) + "' in column " + columns_[c].name +
                " is not a number";
         return false;
+      }
+      if (!time_values_.empty() && columns_[c].is_time()) {
+        // Nanoseconds, as traces wrote time columns before the literals: read exactly.
+        int64_t ns = 0;
+        auto [end, ec] = std::from_chars(cell.text.data(), cell.text.data() + cell.text.size(), ns);
+        if (ec != std::errc() || end != cell.text.data() + cell.text.size()) ns = static_cast<int64_t>((*values)[c]);
+        time_values_[c] = ns;
       }
     }
     prev_t_ = *t;
@@ -296,6 +386,7 @@ class CsvReader final : public TraceReader {
   std::string scratch_, prev_text_;
   int64_t cycle_ns_ = 0, prev_t_ = 0;
   bool have_prev_ = false;
+  bool first_pass_ = false;  // the pass that finds the columns' kinds
   uint64_t state_ = 0;
 };
 
@@ -779,7 +870,16 @@ bool trace_program(const std::vector<TraceColumn>& cols, std::string* source, st
     n->leaf = &c;
   }
   auto type_of = [](const TraceColumn& c) {
-    return c.kind == TraceColumn::Kind::Bool ? "BOOL" : c.kind == TraceColumn::Kind::Int ? "LINT" : "LREAL";
+    switch (c.kind) {
+      case TraceColumn::Kind::Bool: return "BOOL";
+      case TraceColumn::Kind::Int: return "LINT";
+      case TraceColumn::Kind::Real: return "LREAL";
+      case TraceColumn::Kind::Time: return "TIME";
+      case TraceColumn::Kind::Date: return "DATE";
+      case TraceColumn::Kind::Tod: return "TOD";
+      case TraceColumn::Kind::Dt: return "DT";
+    }
+    return "LREAL";
   };
   std::string types, globals, programs;
   int struct_id = 0;

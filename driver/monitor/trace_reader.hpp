@@ -14,7 +14,10 @@ namespace plcfi::monitor {
 
 struct TraceColumn {
   std::string name;  // path as in the header: PosCrane, Main.step, %IX0.1
-  enum class Kind { Bool, Int, Real } kind = Kind::Bool;
+  // Time, Date, Tod, Dt: a CSV column holding IEC literals (T#1s500ms, D#2024-03-01,
+  // TOD#12:00:00, DT#2024-03-01-12:00:00), its values in nanoseconds as plcfi holds them.
+  enum class Kind { Bool, Int, Real, Time, Date, Tod, Dt } kind = Kind::Bool;
+  bool is_time() const { return kind >= Kind::Time; }
 };
 
 enum class TraceFormat { Csv, Vcd };
@@ -37,7 +40,10 @@ class TraceReader {
   // i * cycle_ns; a VCD with cycle_ns > 0 is sampled every cycle, else one state per
   // time stamp. Errors read "FILE:LINE:COL: message" (or "FILE: message" when the file
   // cannot be read at all). A CSV trace is read twice (the first pass finds each
-  // column's type and checks every row), so it must be a regular file.
+  // column's type and checks every row), so it must be a regular file. A CSV cell is a
+  // number, TRUE/FALSE, or a TIME, LTIME, DATE, TOD or DT literal as plcfi's CSV traces
+  // write them (T#1s500ms; a malformed one is an error at its line and column); a plain
+  // number in a time column is its value in nanoseconds, as older traces wrote it.
   static std::unique_ptr<TraceReader> open(const std::string& path, int64_t cycle_ns, std::string* err);
   // The same from memory (tests, fuzzing); `name` stands for the file in messages.
   static std::unique_ptr<TraceReader> from_text(const std::string& name, std::string text, TraceFormat format,
@@ -48,9 +54,14 @@ class TraceReader {
   // Next state; false at the end or on an error (err non-empty then). Times never
   // decrease: a trace whose time goes back is an error at that line.
   virtual bool next(int64_t* t_ns, std::vector<double>* values, std::string* err) = 0;
+  // The values of the state next() gave last, of the columns that are is_time(), in
+  // nanoseconds exactly (a double holds a DT of today to 256 ns only); index = column.
+  // Empty when the trace has no such column.
+  const std::vector<int64_t>& time_values() const { return time_values_; }
 
  protected:
   std::vector<TraceColumn> columns_;
+  std::vector<int64_t> time_values_;
   bool has_time_ = false;
 };
 

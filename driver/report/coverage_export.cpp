@@ -100,7 +100,7 @@ std::vector<uint32_t> coverage_files(const st::Build& b) {
   std::vector<uint32_t> out;
   for (const auto& u : b.units) {
     const st::SourceFile& f = b.sm.file(u->file);
-    if (st::is_library_path(f.path) || f.path.empty() || f.path[0] == '<' || !f.origins.empty()) continue;
+    if (st::is_library_path(f.path) || f.library || f.path.empty() || f.path[0] == '<' || !f.origins.empty()) continue;
     if (test_files.count(u->file) || std::find(out.begin(), out.end(), u->file) != out.end()) continue;
     out.push_back(u->file);
   }

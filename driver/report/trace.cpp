@@ -16,6 +16,12 @@ bool traceable(const st::VarHandle& h, std::string* err) {
   return false;
 }
 
+// TIME, LTIME, DATE, TIME_OF_DAY, DATE_AND_TIME: written to CSV as literals.
+bool is_time_like(st::TypeKind k) {
+  return k == st::TypeKind::Time || k == st::TypeKind::LTime || k == st::TypeKind::Date ||
+         k == st::TypeKind::TimeOfDay || k == st::TypeKind::DateTime;
+}
+
 class FileSink {
  public:
   bool open(const std::string& path, std::string* err) {
@@ -198,6 +204,7 @@ class CsvWriter final : public TraceWriter {
     for (const auto& h : vars_) {
       row += ',';
       if (h.is_bit || h.type->kind == st::TypeKind::Bool) row += st::read_bool(m, h) ? '1' : '0';
+      else if (is_time_like(h.type->kind)) row += st::format(m, h);  // T#1s500ms, D#2024-03-01, ... as --print
       else if (h.type->is_real()) row += fmt::format("{}", st::read_real(m, h));
       else if (h.type->storage() == st::Storage::U64) row += std::to_string(static_cast<uint64_t>(st::read_int(m, h)));
       else row += std::to_string(st::read_int(m, h));

@@ -26,7 +26,9 @@ class TraceWriter {
 // `comment`, when not empty, goes into the header as a $comment (what ran on which plant).
 std::unique_ptr<TraceWriter> open_vcd(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err,
                                       const std::string& comment = "");
-// CSV with a header `time,<path>,...`; time in seconds; BOOL as 0/1.
+// CSV with a header `time,<path>,...`; time in seconds; BOOL as 0/1; TIME, LTIME, DATE,
+// TOD and DT as the IEC literals --print shows (T#1s500ms, D#2024-03-01, TOD#12:00:00,
+// DT#2024-03-01-12:00:00), which the trace reader takes back; other numbers as numbers.
 std::unique_ptr<TraceWriter> open_csv(const std::string& path, const std::vector<st::VarHandle>& vars, std::string* err);
 
 }  // namespace plcfi::report

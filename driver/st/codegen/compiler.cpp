@@ -520,7 +520,7 @@ void Compiler::start_program() {
   app_->types = std::make_unique<TypeTable>();
   tt_ = app_->types.get();
   null_type_ = tt_->null_ref();
-  for (size_t i = 0; i < sm_.size(); ++i) app_->file_paths.push_back(sm_.file(static_cast<uint32_t>(i)).path);
+  for (size_t i = 0; i < sm_.size(); ++i) add_file_path(*app_, static_cast<uint32_t>(i));
   alloc(16, 16);  // address 0 stays invalid: it is the null reference
   app_->image_i = {'I', alloc(opt_.image_size_i, 8), opt_.image_size_i, 0};
   app_->image_q = {'Q', alloc(opt_.image_size_q, 8), opt_.image_size_q, 0};
@@ -534,7 +534,7 @@ void Compiler::start_from(Application& app) {
   app_ = &app;
   tt_ = app.types.get();
   null_type_ = tt_->null_ref();
-  for (size_t i = app.file_paths.size(); i < sm_.size(); ++i) app.file_paths.push_back(sm_.file(static_cast<uint32_t>(i)).path);
+  for (size_t i = app.file_paths.size(); i < sm_.size(); ++i) add_file_path(app, static_cast<uint32_t>(i));
   for (const auto& p : app.pous) {
     src(p.get()).declared = true;  // and compiled: nothing of it is redone
     if (p->is_test) continue;
@@ -868,6 +868,7 @@ bool Compiler::link(Application& app, const std::vector<const CompilationUnit*>&
     app.globals.resize(n_globals);
     app.global_syms.resize(n_global_syms);
     app.file_paths.resize(n_files);
+    app.library_files.resize(n_files);
     app.retain_ranges.resize(n_retain);
     app.type_names.resize(n_type_names);
     app.image_i = image_i;

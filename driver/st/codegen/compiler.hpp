@@ -27,6 +27,9 @@ struct CompileOptions {
   bool test_mode = false;
   bool warnings = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
+  // The source files of libraries (--library; see library_sources in import/import.hpp),
+  // read by build_files before the program's own and compiled with them as library code.
+  std::vector<std::string> library_files;
 };
 
 // Compiles the units (and test files) together with the standard library. Returns null

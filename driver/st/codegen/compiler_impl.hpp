@@ -189,6 +189,11 @@ class Compiler {
 
   // ---- the stages of a run (compiler.cpp)
   void start_program();
+  // Appends file `i` of the source manager to app's file table (path, library or not).
+  void add_file_path(Application& app, uint32_t i) const {
+    app.file_paths.push_back(sm_.file(i).path);
+    app.library_files.push_back(sm_.file(i).library || is_library_path(sm_.file(i).path));
+  }
   void start_from(Application& app);
   void declare_units(const std::vector<const CompilationUnit*>& all, size_t first_pou);
   void check_interfaces(size_t first_pou);

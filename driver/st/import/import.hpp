@@ -20,6 +20,14 @@ enum class InputKind {
 };
 InputKind input_kind(std::string_view path);
 
+// The files of a library given as sources in the folder `dir` (--library DIR), in sorted
+// order: the TwinCAT projects (.plcproj) under it when there are any (a library saved as
+// a PLC project: the objects the project lists), else every ST source (.st), TwinCAT
+// object (.TcPOU, .TcDUT, .TcGVL, .TcIO, .TcTTO) and PLCopen XML file (.xml) under it.
+// Folders are searched recursively; hidden ones (.git) are skipped. False, with the reason
+// in *err (naming `dir`), when dir does not exist, is not a folder or holds no sources.
+bool library_sources(const std::string& dir, std::vector<std::string>* files, std::string* err);
+
 // Reads one project file: loads it into `sm`, adds the ST units it holds (add_generated,
 // with line origins in that file) and appends their file indexes to `units`. Problems of
 // the file itself (not well-formed XML, a POU body in LD, a listed file that is missing)

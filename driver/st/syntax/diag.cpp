@@ -9,6 +9,9 @@ namespace plcfi::st {
 Diagnostic& DiagEngine::report(Severity sev, std::string code, SourceLoc loc, std::string message) {
   std::string context;
   loc = sm_->origin(loc, &context);
+  // A library's warnings are not the program's to fix (as for the built-in libraries,
+  // whose code is compiled without them).
+  if (sev == Severity::Warning && loc.file < sm_->size() && sm_->file(loc.file).library) return overflow_ = Diagnostic{};
   if (!context.empty()) message += " (" + context + ")";
   std::string key = code + '\x1f' + std::to_string(loc.file) + ':' + std::to_string(loc.line) + ':' + std::to_string(loc.col) +
                     '\x1f' + message;

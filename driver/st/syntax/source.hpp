@@ -42,6 +42,9 @@ struct SourceFile {
     uint32_t file = 0;
   };
   std::vector<Origin> origins;
+  // A file of a library given as sources (--library): its code is library code, like the
+  // libraries plcfi brings (no warnings, coverage or listing of its own).
+  bool library = false;
 
   std::string_view line_text(uint32_t line) const;  // without the line break
 };
@@ -62,6 +65,11 @@ class SourceManager {
   SourceLoc origin(SourceLoc loc, std::string* context = nullptr) const;
 
   const SourceFile& file(uint32_t index) const { return *files_[index]; }
+  // Marks the files from `first` on (the ones a library's sources were loaded into) as
+  // library files.
+  void mark_library(uint32_t first) {
+    for (size_t i = first; i < files_.size(); ++i) files_[i]->library = true;
+  }
   size_t size() const { return files_.size(); }
 
  private:

@@ -197,6 +197,8 @@ class Application {
   std::vector<std::unique_ptr<Symbol>> global_syms;
   std::vector<std::unique_ptr<PouInfo>> pous;
   std::vector<std::string> file_paths;  // file index -> path
+  // file index -> a library's (the built-in ones or --library): no coverage or listing
+  std::vector<bool> library_files;
   uint32_t mstack_addr = 0, mstack_size = 0;  // method frames (dynamic)
   ImageArea image_i{'I', 0, 0}, image_q{'Q', 0, 0}, image_m{'M', 0, 0};
   std::unique_ptr<TypeTable> types;
@@ -210,6 +212,7 @@ class Application {
 
   SourceLoc loc_of(uint32_t pc) const;
   std::string where(SourceLoc loc) const;  // "file:line:col"
+  bool is_library_file(uint32_t file) const { return file < library_files.size() && library_files[file]; }
   PouInfo* find_pou(std::string_view name) const;
   const ImageArea* image(char area) const;
 };

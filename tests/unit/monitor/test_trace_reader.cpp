@@ -68,6 +68,61 @@ class TempDir {
 
 }  // namespace
 
+// TIME/LTIME, DATE, TOD and DT literals as plcfi's CSV traces write them: each column is
+// typed by its literals, the values are nanoseconds (exact in time_values()), and a plain
+// number in such a column keeps its old meaning (nanoseconds).
+TEST(TraceReaderCsv, ReadsTimeLiterals) {
+  std::string err;
+  auto r = csv("time,v_t,v_d,v_tod,v_dt,n\n"
+               "0,T#1s500ms,D#2024-03-01,TOD#01:00:00,DT#2024-03-01-12:00:00.25,3\n"
+               "0.01,LTIME#-2ms,DATE#1970-01-02,TIME_OF_DAY#00:00:00.001,1709294400250000001,4\n",
+               &err);
+  ASSERT_TRUE(r) << err;
+  ASSERT_EQ(r->columns().size(), 5u);
+  EXPECT_EQ(r->columns()[0].kind, TraceColumn::Kind::Time);
+  EXPECT_EQ(r->columns()[1].kind, TraceColumn::Kind::Date);
+  EXPECT_EQ(r->columns()[2].kind, TraceColumn::Kind::Tod);
+  EXPECT_EQ(r->columns()[3].kind, TraceColumn::Kind::Dt);
+  EXPECT_EQ(r->columns()[4].kind, TraceColumn::Kind::Int);
+  int64_t t = 0;
+  std::vector<double> v;
+  ASSERT_TRUE(r->next(&t, &v, &err)) << err;
+  ASSERT_EQ(r->time_values().size(), 5u);
+  EXPECT_EQ(r->time_values()[0], 1'500'000'000);
+  EXPECT_EQ(r->time_values()[1], 19'783 * 86'400'000'000'000);
+  EXPECT_EQ(r->time_values()[2], 3'600'000'000'000);
+  EXPECT_EQ(r->time_values()[3], 1'709'294'400'250'000'000);
+  EXPECT_DOUBLE_EQ(v[0], 1.5e9);
+  EXPECT_DOUBLE_EQ(v[4], 3);
+  ASSERT_TRUE(r->next(&t, &v, &err)) << err;
+  EXPECT_EQ(r->time_values()[0], -2'000'000);
+  EXPECT_EQ(r->time_values()[1], 86'400'000'000'000);
+  EXPECT_EQ(r->time_values()[2], 1'000'000);
+  EXPECT_EQ(r->time_values()[3], 1'709'294'400'250'000'001);  // a plain number: nanoseconds, exactly
+  EXPECT_FALSE(r->next(&t, &v, &err));
+  EXPECT_EQ(err, "");
+  std::string program;
+  ASSERT_TRUE(trace_program(r->columns(), &program, &err)) << err;
+  EXPECT_NE(program.find("v_t : TIME;"), std::string::npos) << program;
+  EXPECT_NE(program.find("v_dt : DT;"), std::string::npos) << program;
+}
+
+TEST(TraceReaderCsv, MalformedTimeLiteralsAreErrorsAtTheirPlace) {
+  std::string err;
+  EXPECT_FALSE(csv("time,t\n0,T#1s\n0.1,T#1x\n", &err));
+  EXPECT_EQ(err.rfind("t.csv:3:", 0), 0u) << err;
+  EXPECT_NE(err.find("'T#1x' in column t is not a number or a TIME, DATE, TOD or DT literal"), std::string::npos) << err;
+  EXPECT_FALSE(csv("time,a,d\n0,1,D#2024-02-30\n", &err));
+  EXPECT_EQ(err.rfind("t.csv:2:", 0), 0u) << err;
+  EXPECT_NE(err.find("'D#2024-02-30' in column d"), std::string::npos) << err;
+  EXPECT_FALSE(csv("time,d\n0,D#2024-03-01\n0.1,TOD#12:00:00\n", &err));
+  EXPECT_EQ(err, "t.csv:3:5: 'TOD#12:00:00' in column d is a TOD literal; the column's earlier literals are DATE");
+  EXPECT_FALSE(csv("time,x\n0,INT#5\n", &err));
+  EXPECT_EQ(err, "t.csv:2:3: 'INT#5' in column x is not a number or a TIME, DATE, TOD or DT literal");
+  EXPECT_FALSE(csv("time,x\n0,T#1s T#2s\n", &err));
+  EXPECT_EQ(err, "t.csv:2:8: 'T#1s T#2s' in column x is not a number or a TIME, DATE, TOD or DT literal: unexpected text after the literal");
+}
+
 TEST(TraceReaderCsv, ReadsTimeKindsAndValues) {
   std::string err;
   auto r = csv("time, a, n, x\n0.0, 0, 1, 0.5\n\n0.5, 1, 7, 2\r\n1.0, TRUE, -3, 1\n", &err);
