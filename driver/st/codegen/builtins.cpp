@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "compiler_impl.hpp"
 #include "sema/stdfuncs.hpp"
 
@@ -154,6 +156,7 @@ Emitter emitter_of(StdFamily f) {
     case F::Replace: return &Compiler::emit_replace;
     case F::AddressOf: return &Compiler::emit_address_of;
     case F::SizeOf: return &Compiler::emit_sizeof;
+    case F::Bound: return &Compiler::emit_bound;
     case F::IsValidRef: return &Compiler::emit_is_valid_ref;
     case F::Now: return &Compiler::emit_now;
     case F::Temporal: return &Compiler::emit_temporal;
@@ -769,6 +772,37 @@ std::optional<Val> Compiler::emit_sizeof(const StdFunc& f, const CallExpr& c) {
   out.type = elem(TypeKind::UDInt);
   out.c = ConstV{ConstV::K::Int, t->size, 0, {}};
   return out;
+}
+
+// LOWER_BOUND(arr, dim) / UPPER_BOUND(arr, dim): a DINT, constant for an array whose
+// bounds are declared, read from the in-out's slot for an ARRAY[*].
+std::optional<Val> Compiler::emit_bound(const StdFunc& f, const CallExpr& c) {
+  auto args = positional(c, f);
+  if (args.size() != 2) return bad();
+  Place arr = place(*args[0], false);
+  if (!arr.ok) return bad();
+  if (arr.type->kind != TypeKind::Array) {
+    diags_.error("ST210", args[0]->loc, std::string(f.name) + " needs an array, not " + arr.type->name);
+    return bad();
+  }
+  auto dim = const_int(*args[1], b_->file);
+  if (!dim) return bad();
+  if (*dim < 1 || static_cast<uint64_t>(*dim) > arr.type->dims.size()) {
+    diags_.error("ST210", args[1]->loc, fmt::format("{}: dimension {} of {}, which has {}", f.name, *dim, arr.type->name, arr.type->dims.size()));
+    return bad();
+  }
+  const bool upper = f.name == "UPPER_BOUND";
+  const auto d = static_cast<size_t>(*dim - 1);
+  if (!arr.type->open) {
+    Val out;
+    out.is_const = true;
+    out.type = elem(TypeKind::DInt);
+    out.c = ConstV{ConstV::K::Int, upper ? arr.type->dims[d].hi : arr.type->dims[d].lo, 0, {}};
+    return out;
+  }
+  Place b;
+  if (!open_bound(arr, d, upper, c.loc, &b)) return bad();
+  return load(b);
 }
 
 // The Tc2_System functions: each argument converted to its operand's type as a call of

@@ -474,7 +474,7 @@ void Compiler::init_function_frame(PouInfo* f, Slot frame, const std::vector<con
   };
   mark_bytes(0, 8, 1);  // the header: a FUNCTION's is never read
   for (auto [off, size] : written_first(f)) mark_bytes(off, size, 1);
-  for (const Symbol* s : stored) mark_bytes(s->offset, s->where == Where::InOut ? 4 : s->type->size, 0);
+  for (const Symbol* s : stored) mark_bytes(s->offset, s->where == Where::InOut ? inout_slot_size(s->type) : s->type->size, 0);
   // Needed runs, joined across short either-way gaps when that saves an instruction.
   std::vector<std::pair<uint32_t, uint32_t>> runs;  // [from, to) relative to tmpl_from
   for (uint32_t k = 0; k < need.size();) {
@@ -566,14 +566,7 @@ Val Compiler::call_function(PouInfo* f, const CallExpr& c) {
       if (params[i] == p) given[i] = true;
     if (!a.value) continue;
     if (p->where == Where::InOut) {
-      Place src = place(*a.value, true);
-      if (!src.ok) continue;
-      if (!same_type(src.type, p->type) && src.type != p->type && !derives(src.type, p->type)) {
-        diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a variable of type " + p->type->name + ", not " + src.type->name);
-        continue;
-      }
-      store(frame_place(frame.plus(p->offset), elem(TypeKind::UDInt)), addr_of(src, a.value->loc));
-      stored.push_back(p);
+      if (bind_inout(frame_place(frame.plus(p->offset), elem(TypeKind::UDInt)), p, *a.value)) stored.push_back(p);
       continue;
     }
     if (is_reference(p->type)) {  // a REFERENCE TO input is bound to the argument
@@ -682,13 +675,7 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     field.off = inst.off + p->offset;
     field.readonly = false;
     if (p->where == Where::InOut) {
-      Place src = place(*a.value, true);
-      if (!src.ok) continue;
-      if (!same_type(src.type, p->type) && src.type != p->type && !derives(src.type, p->type)) {
-        diags_.error("ST222", a.value->loc, "VAR_IN_OUT '" + p->name + "' needs a variable of type " + p->type->name + ", not " + src.type->name);
-        continue;
-      }
-      store(field, addr_of(src, a.value->loc));
+      bind_inout(field, p, *a.value);
       continue;
     }
     if (is_reference(p->type)) {  // a REFERENCE TO input is bound to the argument
@@ -872,6 +859,7 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
     call_after[k - 1] = call_after[k] || (bound[order[k]]->value && may_call(*bound[order[k]]->value));
   struct Staged {
     Val v;
+    std::vector<Slot> bounds;  // ARRAY[*] in-out: the argument's bounds
     bool direct = true;  // v still to be coerced into the field; else v.slot holds the field's value
     bool ok = false;
   };
@@ -883,10 +871,8 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
     if (!a->value) continue;
     Staged& st = staged[i];
     if (p->where == Where::InOut) {
-      Place src = place(*a->value, true);
-      if (!src.ok) continue;
+      if (!stage_inout(p, *a->value, &st.v.slot, &st.bounds)) continue;
       st.v.type = elem(TypeKind::UDInt);
-      st.v.slot = addr_of(src, a->loc);
     } else if (is_reference(p->type)) {  // a REFERENCE TO input is bound to the argument
       st.v = reference_to_var(p->type, *a->value);
       if (!st.v.ok) continue;
@@ -924,7 +910,7 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
         diags_.error("ST224", loc, "VAR_IN_OUT '" + p->name + "' of method " + m->name + " must be passed");
         continue;
       }
-      if (staged[i].ok) store(field, staged[i].v.slot);
+      if (staged[i].ok) store_inout(field, staged[i].v.slot, staged[i].bounds);
       continue;
     }
     if (const FixedArg* f = fixed_of(p)) {

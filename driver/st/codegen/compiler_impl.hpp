@@ -371,6 +371,19 @@ class Compiler {
   bool lifecycle_needed(const Type* t, bool exit);
   // Whether the instances p holds (its own variables and its base FB's) need it.
   bool members_need(PouInfo* p, bool exit);
+  // ---- ARRAY[*] (places.cpp): a VAR_IN_OUT slot holds the address, then for an open
+  // array LOWER and UPPER (DINT) of each dimension.
+  static uint32_t inout_slot_size(const Type* t) { return t && t->open ? 4 + 8 * static_cast<uint32_t>(t->dims.size()) : 4; }
+  // The DINT slot of dimension `dim`'s bound in an open array's descriptor (the place of
+  // the in-out itself); false, after an error, where the place has no descriptor.
+  bool open_bound(const Place& arr, size_t dim, bool upper, SourceLoc loc, Place* out);
+  // Binds a VAR_IN_OUT's slot (the place of its address) to an argument: the address,
+  // and for ARRAY[*] the argument's bounds.
+  bool bind_inout(const Place& slot, const Symbol* param, const Expr& arg);
+  // The same in two steps (a METHOD's arguments are evaluated before its frame exists).
+  bool stage_inout(const Symbol* param, const Expr& arg, Slot* addr, std::vector<Slot>* bounds);
+  void store_inout(const Place& slot, Slot addr, const std::vector<Slot>& bounds);
+  Place open_index_place(const Place& base, const IndexExpr& e);
   // CODESYS computes an initial value that is not a constant expression (other variables,
   // ADR(x)) when the variable is initialised, in declaration order: an FB's or PROGRAM's
   // in its init entry (before the FB_init of what it holds), a FUNCTION's or METHOD's on
@@ -436,6 +449,7 @@ class Compiler {
   std::optional<Val> emit_replace(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_address_of(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_sizeof(const StdFunc& f, const CallExpr& c);
+  std::optional<Val> emit_bound(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_is_valid_ref(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_now(const StdFunc& f, const CallExpr& c);
   std::optional<Val> emit_temporal(const StdFunc& f, const CallExpr& c);
@@ -490,6 +504,7 @@ class Compiler {
   std::unordered_map<std::string, std::pair<const VarDecl*, uint32_t>> global_consts_;
   std::unordered_map<const PouInfo*, std::vector<const Symbol*>> runtime_inits_;
   std::vector<const Symbol*> global_runtime_inits_;  // declaration order
+  bool open_array_ok_ = false;  // resolving a VAR_IN_OUT's type: ARRAY[*] allowed
   std::vector<std::unique_ptr<Body>> bodies_;  // finished bodies waiting for final layout
   std::vector<std::pair<Body*, std::vector<uint32_t>*>> pending_;
   Body* b_ = nullptr;  // body being compiled

@@ -215,11 +215,36 @@ const Type* Compiler::resolve_type(const TypeSpec& spec, uint32_t file, const st
     }
     case TypeSpecKind::Array: {
       if (!spec.element) break;
+      const bool open_ok = open_array_ok_;
+      open_array_ok_ = false;  // not for the element type
       const Type* el = resolve_type(*spec.element, file);
+      open_array_ok_ = open_ok;
       if (!el) break;
       std::vector<Type::Dim> dims;
       uint64_t count = 1;
       bool ok = true;
+      const size_t open = static_cast<size_t>(std::count_if(spec.dims.begin(), spec.dims.end(), [](const auto& r) { return r.open; }));
+      if (open) {
+        // ARRAY[*]: the bounds are the argument's (a VAR_IN_OUT only, checked where declared).
+        if (open != spec.dims.size()) {
+          diags_.error("ST229", spec.loc, "ARRAY[*] has '*' for every dimension or for none");
+          break;
+        }
+        if (!open_ok) {
+          diags_.error("ST229", spec.loc, "ARRAY[*] is the type of a VAR_IN_OUT only: its bounds are the argument's");
+          break;
+        }
+        std::string nm = "ARRAY [*";
+        for (size_t i = 1; i < open; ++i) nm += ", *";
+        nm += "] OF " + el->name;
+        Type* t = tt_->make(TypeKind::Array, nm);
+        t->elem = el;
+        t->dims.assign(open, Type::Dim{0, 0});
+        t->open = true;
+        t->align = el->align;
+        result = t;
+        break;
+      }
       for (const auto& r : spec.dims) {
         if (!r.lo || !r.hi) {
           ok = false;
@@ -1062,8 +1087,10 @@ void Compiler::declare_vars(PouInfo* p) {
         }
         init_args_ok_ = (p->kind == PouKind::FunctionBlock || p->kind == PouKind::Program) &&
                         (sec == VarSection::Var || sec == VarSection::Input || sec == VarSection::Output);
+        open_array_ok_ = sec == VarSection::InOut;
         const Type* t = d.type ? resolve_type(*d.type, p->file) : nullptr;
         init_args_ok_ = false;
+        open_array_ok_ = false;
         if (!t) continue;
         if (t->kind == TypeKind::Pou && t->pou == p) {
           diags_.error("ST240", d.loc, p->name + " cannot contain an instance of itself");
@@ -1086,7 +1113,7 @@ void Compiler::declare_vars(PouInfo* p) {
             continue;
           }
           if (sec == VarSection::InOut) {
-            place_var(s, 4, 4);
+            place_var(s, inout_slot_size(t), 4);
             s->where = Where::InOut;
           } else if (sec == VarSection::Stat) {
             // One per POU, shared by every instance and call: laid out like a global.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <optional>
 
+#include <fmt/format.h>
+
 #include "compiler_impl.hpp"
 
 namespace plcfi::st::detail {
@@ -398,6 +400,7 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     diags_.error("ST208", e.loc, t->name + " needs " + std::to_string(t->dims.size()) + " index(es), not " + std::to_string(e.indices.size()));
     return bad_place;
   }
+  if (t->open) return open_index_place(base, e);
   uint32_t esize = t->elem->size;
   // Strides per dimension (row-major).
   std::vector<uint64_t> stride(t->dims.size());
@@ -503,6 +506,131 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
   return p;
 }
 
+// ------------------------------------------------------------------ ARRAY[*]
+
+bool Compiler::open_bound(const Place& arr, size_t dim, bool upper, SourceLoc loc, Place* out) {
+  const Symbol* s = arr.sym;
+  if (arr.k != Place::K::Ind || !s || s->where != Where::InOut || !s->type || !s->type->open) {
+    diags_.error("ST208", loc, "the bounds of this ARRAY[*] are not known here: only the POU whose VAR_IN_OUT it is "
+                               "can index it or ask LOWER_BOUND/UPPER_BOUND");
+    return false;
+  }
+  Place b;
+  b.k = Place::K::Frame;
+  b.sk = SK::Var;
+  b.off = s->offset + 4 + 8 * static_cast<uint32_t>(dim) + (upper ? 4 : 0);
+  b.type = elem(TypeKind::DInt);
+  *out = b;
+  return true;
+}
+
+// arr[i, j]: every index checked against the argument's bounds at run time, then the
+// element at (((i - lo0) * n1 + (j - lo1)) * ...) * SIZEOF(element) from the address.
+Place Compiler::open_index_place(const Place& base, const IndexExpr& e) {
+  Place bad_place;
+  bad_place.ok = false;
+  const Type* t = base.type;
+  const Type* dint = elem(TypeKind::DInt);
+  Slot linear;
+  for (size_t i = 0; i < e.indices.size(); ++i) {
+    Place lo_p, hi_p;
+    if (!open_bound(base, i, false, e.loc, &lo_p) || !open_bound(base, i, true, e.loc, &hi_p)) return bad_place;
+    Val v = expr(*e.indices[i], dint);
+    if (!v.ok) return bad_place;
+    if (!v.type ? v.c.k != ConstV::K::Int : !(v.type->is_integer() || v.type->is_bitstring() || v.type->kind == TypeKind::Enum)) {
+      diags_.error("ST208", e.indices[i]->loc, "an array index must be an integer, not " + tname(v.type));
+      return bad_place;
+    }
+    const Type* it = v.type ? v.type : dint;
+    Slot ix = to_slot(v, it, e.indices[i]->loc);
+    if (it->size == 8 || (it->size == 4 && !it->is_signed())) {
+      // Index arithmetic is 32-bit: a wider index is first checked in its own type.
+      Slot los = konst(it, ConstV{ConstV::K::Int, it->is_signed() ? INT32_MIN : 0, 0, {}}, e.indices[i]->loc);
+      Slot his = konst(it, ConstV{ConstV::K::Int, INT32_MAX, 0, {}}, e.indices[i]->loc);
+      mark(e.indices[i]->loc);
+      emit(int_op(Op::CHK_I8, it->storage()), {ix, los, his, 1u});
+    }
+    ix = convert(ix, it, dint);
+    Slot lo = load(lo_p).slot, hi = load(hi_p).slot;
+    mark(e.indices[i]->loc);
+    emit(Op::CHK_I32, {ix, lo, hi, 1u});
+    Slot d = temp(4, 4);
+    emit(Op::SUB_I32, {d, ix, lo});
+    if (i == 0) {
+      linear = d;
+      continue;
+    }
+    Slot extent = temp(4, 4), next = temp(4, 4);
+    emit(Op::SUB_I32, {extent, hi, lo});
+    emit(Op::ADD_I32, {extent, extent, konst(dint, ConstV{ConstV::K::Int, 1, 0, {}}, e.loc)});
+    emit(Op::MUL_I32, {next, linear, extent});
+    emit(Op::ADD_I32, {next, next, d});
+    linear = next;
+  }
+  Slot bytes = temp(4, 4), addr = temp(4, 4);
+  emit(Op::MUL_I32, {bytes, linear, konst(dint, ConstV{ConstV::K::Int, t->elem->size, 0, {}}, e.loc)});
+  emit(Op::ADD_I32, {addr, addr_of(base, e.loc), bytes});
+  Place p;
+  p.k = Place::K::Ind;
+  p.type = t->elem;
+  p.ptr = addr;
+  p.off = 0;
+  p.readonly = base.readonly;
+  return p;
+}
+
+bool Compiler::stage_inout(const Symbol* param, const Expr& arg, Slot* addr, std::vector<Slot>* bounds) {
+  Place src = place(arg, true);
+  if (!src.ok) return false;
+  const Type* pt = param->type;
+  const Type* st = src.type;
+  if (pt->open) {
+    if (st->kind != TypeKind::Array || st->dims.size() != pt->dims.size() || !same_type(st->elem, pt->elem)) {
+      diags_.error("ST222", arg.loc, fmt::format("VAR_IN_OUT '{}' ({}) needs an array of {} with {} dimension(s), not {}", param->name,
+                                                 pt->name, pt->elem->name, pt->dims.size(), st->name));
+      return false;
+    }
+    for (size_t i = 0; i < st->dims.size(); ++i)
+      for (bool upper : {false, true}) {
+        if (st->open) {  // passed on: the bounds of the caller's argument
+          Place b;
+          if (!open_bound(src, i, upper, arg.loc, &b)) return false;
+          bounds->push_back(load(b).slot);
+        } else {
+          bounds->push_back(konst(elem(TypeKind::DInt), ConstV{ConstV::K::Int, upper ? st->dims[i].hi : st->dims[i].lo, 0, {}}, arg.loc));
+        }
+      }
+  } else if (st->open) {
+    diags_.error("ST222", arg.loc, "VAR_IN_OUT '" + param->name + "' needs a variable of type " + pt->name + ", not an ARRAY[*]");
+    return false;
+  } else if (!same_type(st, pt) && st != pt && !derives(st, pt)) {
+    diags_.error("ST222", arg.loc, "VAR_IN_OUT '" + param->name + "' needs a variable of type " + pt->name + ", not " + st->name);
+    return false;
+  }
+  *addr = addr_of(src, arg.loc);
+  return true;
+}
+
+void Compiler::store_inout(const Place& slot, Slot addr, const std::vector<Slot>& bounds) {
+  Place a = slot;
+  a.type = elem(TypeKind::UDInt);
+  store(a, addr);
+  for (size_t k = 0; k < bounds.size(); ++k) {
+    Place b = slot;
+    b.off += 4 + 4 * static_cast<uint32_t>(k);
+    b.type = elem(TypeKind::DInt);
+    store(b, bounds[k]);
+  }
+}
+
+bool Compiler::bind_inout(const Place& slot, const Symbol* param, const Expr& arg) {
+  Slot addr;
+  std::vector<Slot> bounds;
+  if (!stage_inout(param, arg, &addr, &bounds)) return false;
+  store_inout(slot, addr, bounds);
+  return true;
+}
+
 Place Compiler::deref_place(Val ptr, const Type* target, SourceLoc loc) {
   Place p;
   p.k = Place::K::Ind;
@@ -598,6 +726,12 @@ Val Compiler::load(const Place& p) {
   Val v;
   v.type = p.type;
   if (!p.ok) return bad();
+  if (p.type && p.type->open) {
+    // At the statement being compiled: a load has no location of its own.
+    diags_.error("ST203", b_ && !b_->lines.empty() ? b_->lines.back().second : SourceLoc{},
+                 "an ARRAY[*] has no value of its own: index it, or pass it to another ARRAY[*]");
+    return bad();
+  }
   if (p.k == Place::K::FrameIdx && !p.type->is_elementary()) {
     Place ind = p;
     ind.k = Place::K::Ind;
@@ -755,6 +889,10 @@ void Compiler::store(const Place& p, Slot src) {
 
 void Compiler::assign(const Place& dst, const Val& v, SourceLoc loc) {
   if (!dst.ok || !v.ok) return;
+  if (dst.type->open || (v.type && v.type->open)) {
+    diags_.error("ST203", loc, "an ARRAY[*] is not assigned whole: copy it element by element (LOWER_BOUND/UPPER_BOUND give its bounds)");
+    return;
+  }
   if (dst.readonly) {
     diags_.error("ST206", loc, dst.sym ? "'" + dst.sym->name + "' is a constant and cannot be assigned" : "this expression cannot be assigned");
     return;

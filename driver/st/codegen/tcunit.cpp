@@ -156,6 +156,10 @@ PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
     const int i = x == e ? 0 : 1;
     Place p = place(*x->value, false);
     if (!p.ok) return nullptr;
+    if (p.type->open) {
+      diags_.error("ST242", x->value->loc, "plcfi's AssertArrayEquals takes arrays whose bounds are declared, not an ARRAY[*]");
+      return nullptr;
+    }
     if (p.type->kind != TypeKind::Array || p.type->dims.size() != ndims || !iequals(tcunit_suffix(p.type->elem), want)) {
       diags_.error("ST242", x->loc,
                    fmt::format("{} of {} must be an ARRAY {}OF {}, not {}", x == e ? first : second, m->name,

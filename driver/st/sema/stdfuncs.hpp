@@ -35,6 +35,7 @@ enum class StdFamily : uint8_t {
   Replace,        // REPLACE
   AddressOf,      // ADR, REF
   SizeOf,         // SIZEOF
+  Bound,          // LOWER_BOUND, UPPER_BOUND (of an array, ARRAY[*] too)
   IsValidRef,     // __ISVALIDREF (CODESYS): whether a REFERENCE TO is bound
   Now,            // __NOW: the virtual clock, in generated code only
   Temporal,       // RISING, CHANGES, PASSED, ... (temporal): requirement monitors only

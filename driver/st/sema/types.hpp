@@ -52,6 +52,9 @@ struct Type {
     int64_t lo, hi;
   };
   std::vector<Dim> dims;
+  // ARRAY[*] (only a VAR_IN_OUT's type): the bounds are the argument's, known at run time
+  // from the in-out's slot (address, then LOWER/UPPER per dimension); dims holds zeros.
+  bool open = false;
   // Struct: members.
   std::vector<Field> fields;
   bool is_union = false;  // UNION (CODESYS): every field at offset 0, the size of the largest

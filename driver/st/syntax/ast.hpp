@@ -209,6 +209,7 @@ struct TypeSpec {
   // Array:
   struct Range {
     ExprPtr lo, hi;
+    bool open = false;  // `*` (ARRAY[*], a VAR_IN_OUT whose bounds are the argument's)
   };
   std::vector<Range> dims;
   std::unique_ptr<TypeSpec> element;  // Array element, Ref target, Subrange/Enum base (may be null for enums)

@@ -179,7 +179,7 @@ std::string dump(const TypeSpec& t) {
       std::string s = "ARRAY[";
       for (size_t i = 0; i < t.dims.size(); ++i) {
         if (i) s += ", ";
-        s += opt(t.dims[i].lo) + ".." + opt(t.dims[i].hi);
+        s += t.dims[i].open ? std::string("*") : opt(t.dims[i].lo) + ".." + opt(t.dims[i].hi);
       }
       return s + "] OF " + (t.element ? dump(*t.element) : "_");
     }

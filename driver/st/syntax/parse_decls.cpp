@@ -162,6 +162,12 @@ TypeSpecPtr Parser::parse_type_spec() {
     if (expect(Tok::LBracket, "ST119", "after ARRAY")) {
       do {
         TypeSpec::Range r;
+        if (at(Tok::Star) && (la(1).kind == Tok::Comma || la(1).kind == Tok::RBracket)) {
+          advance();
+          r.open = true;
+          spec->dims.push_back(std::move(r));
+          continue;
+        }
         r.lo = parse_expr();
         if (!accept(Tok::DotDot)) {
           error("ST119", missing_loc(), "expected '..' in the array bounds (e.g. ARRAY [1..10] OF INT), found " +
