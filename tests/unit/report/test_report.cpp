@@ -180,9 +180,9 @@ TEST_F(TraceTest, CsvRowsPerSample) {
   std::string path = temp_path("t.csv"), err;
   EXPECT_EQ(record(open_csv(path, vars_, &err), path),
             "time,P.run,P.n,P.u,P.level,P.t,P.pr.a,P.pr.b\n"
-            "0,0,0,0,0,0,0,0\n"
-            "0.01,1,-3,65535,2.5,1500000000,0,1\n"
-            "0.02,1,-3,65535,2.5,1500000000,0,1\n");
+            "0,0,0,0,0,T#0s,0,0\n"
+            "0.01,1,-3,65535,2.5,T#1s500ms,0,1\n"
+            "0.02,1,-3,65535,2.5,T#1s500ms,0,1\n");
 }
 
 TEST_F(TraceTest, RefusesWhatATraceCannotHold) {
