@@ -57,8 +57,10 @@ void read_digits(std::string_view text, size_t* i, std::string* digits) {
 
 }  // namespace
 
-DurationParse parse_duration_body(std::string_view text) {
-  constexpr const char* kRange = "out of range (at most 106751d23h47m16s854ms775us807ns, about 292 years)";
+namespace {
+DurationParse parse_body(std::string_view text, bool unsigned64) {
+  const char* kRange = unsigned64 ? "out of range (at most 213503d23h34m33s709ms551us615ns, 2^64 - 1 ns)"
+                                  : "out of range (at most 106751d23h47m16s854ms775us807ns, about 292 years)";
   size_t i = 0;
   bool negative = false;
   if (i < text.size() && (text[i] == '-' || text[i] == '+')) {
@@ -68,7 +70,7 @@ DurationParse parse_duration_body(std::string_view text) {
   if (i >= text.size()) return failure(i, "expected a duration such as 1h2m3s4ms");
   // The sum is kept as a non-negative magnitude up to 2^63, so INT64_MIN itself is reachable.
   U128 total = 0;
-  const U128 limit = negative ? (U128{1} << 63) : (U128{1} << 63) - 1;
+  const U128 limit = negative ? (U128{1} << 63) : unsigned64 ? (U128{1} << 64) - 1 : (U128{1} << 63) - 1;
   bool first = true;
   while (i < text.size()) {
     if (!first && text[i] == '_' && i + 1 < text.size() && is_digit(text[i + 1])) ++i;  // 1s_500ms
@@ -101,10 +103,10 @@ DurationParse parse_duration_body(std::string_view text) {
     }
     const int64_t per = unit_ns(unit);
     if (per == 0) return failure(unit_at, "unknown duration unit '" + std::string(unit) + "' " + kUnits);
-    // Whole units: 20 digits already exceed 2^63 ns for every unit.
+    // Whole units: 21 digits already exceed 2^64 ns for every unit (and fit in 128 bits).
     size_t lead = 0;
     while (lead + 1 < whole.size() && whole[lead] == '0') ++lead;
-    if (whole.size() - lead > 19) return failure(num_at, kRange);
+    if (whole.size() - lead > 20) return failure(num_at, kRange);
     U128 count = 0;
     for (size_t k = lead; k < whole.size(); ++k) count = count * 10 + static_cast<unsigned>(whole[k] - '0');
     U128 part = count * static_cast<U128>(per);
@@ -134,8 +136,13 @@ DurationParse parse_duration_body(std::string_view text) {
   // total <= 2^63 when negative: the two's complement of its low 64 bits is the value.
   const uint64_t magnitude = static_cast<uint64_t>(total);
   r.ns = negative ? static_cast<int64_t>(uint64_t{0} - magnitude) : static_cast<int64_t>(magnitude);
+  r.beyond_signed = !negative && magnitude > static_cast<uint64_t>(INT64_MAX);
   return r;
 }
+}  // namespace
+
+DurationParse parse_duration_body(std::string_view text) { return parse_body(text, false); }
+DurationParse parse_unsigned_duration_body(std::string_view text) { return parse_body(text, true); }
 
 DurationParse parse_duration(std::string_view text) {
   size_t hash = text.find('#');

@@ -22,6 +22,7 @@ struct DurationParse {
   int64_t ns = 0;
   std::string error;     // empty: ok
   size_t error_at = 0;   // offset into the parsed text
+  bool beyond_signed = false;  // parse_unsigned_duration_body: above INT64_MAX
   bool ok() const { return error.empty(); }
 };
 
@@ -31,6 +32,11 @@ struct DurationParse {
 // 8,200,000 ns; a fraction finer than 1 ns, a value beyond int64 nanoseconds (about 292
 // years) and malformed text ("1.2.3ms", "5", "ms", "10xs") are errors.
 DurationParse parse_duration_body(std::string_view body);
+// LTIME as CODESYS and TwinCAT hold it: unsigned 64-bit nanoseconds, up to
+// 213503d23h34m33s709ms551us615ns (2^64 - 1). `ns` holds the bits; `beyond_signed` says the
+// value is above INT64_MAX (then it is no signed duration). A negative value keeps the
+// signed limit.
+DurationParse parse_unsigned_duration_body(std::string_view body);
 
 // The same, with an optional T#, TIME#, LT# or LTIME# prefix (any case): the form of
 // spec files and options. error_at counts from the start of `text`, prefix included.

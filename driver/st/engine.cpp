@@ -593,7 +593,10 @@ std::string format(const Machine& m, const VarHandle& h) {
   switch (t->kind) {
     case TypeKind::Real: return fmt::format("{}", load_as<float>(p));
     case TypeKind::LReal: return fmt::format("{}", load_as<double>(p));
-    case TypeKind::Time: case TypeKind::LTime: return duration(load_as<int64_t>(p));
+    case TypeKind::LTime:
+      if (t->unsigned_count) return unsigned_duration_literal(load_as<uint64_t>(p));
+      return duration(load_as<int64_t>(p));
+    case TypeKind::Time: return duration(load_as<int64_t>(p));
     case TypeKind::Date: return date_literal(load_as<int64_t>(p));
     case TypeKind::TimeOfDay: return tod_literal(load_as<int64_t>(p));
     case TypeKind::DateTime: return dt_literal(load_as<int64_t>(p));

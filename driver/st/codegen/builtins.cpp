@@ -174,8 +174,9 @@ Emitter emitter_of(StdFamily f) {
 // DATE_AND_TIME in seconds since 1970-01-01 and TIME_OF_DAY in ms since midnight, and
 // their conversions give those counts. MATIEC (--dialect iec) converts DATE, DT and TOD
 // to whole seconds (its tv_sec); TIME keeps plcfi's milliseconds in both dialects.
-int64_t count_unit_ns(TypeKind k, Dialect dialect) {
-  switch (k) {
+int64_t count_unit_ns(const Type* t, Dialect dialect) {
+  if (t->long_date) return 1;  // LDATE, LTOD, LDT: nanoseconds
+  switch (t->kind) {
     case TypeKind::Time: return 1'000'000;
     case TypeKind::Date: case TypeKind::DateTime: return 1'000'000'000;
     case TypeKind::TimeOfDay: return dialect == Dialect::Codesys ? 1'000'000 : 1'000'000'000;
@@ -333,8 +334,8 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
   TypeKind tk = to->kind;
   // Nanoseconds per count when a time-like value becomes a number and back (see
   // count_unit_ns): the unit is the one the PLC stores the type in.
-  int64_t from_unit = count_unit_ns(fk, opt_.dialect);
-  int64_t to_unit = count_unit_ns(tk, opt_.dialect);
+  int64_t from_unit = count_unit_ns(from, opt_.dialect);
+  int64_t to_unit = count_unit_ns(to, opt_.dialect);
   switch (kind) {
     case ConversionKind::None:
       if (!conv.trunc) return std::nullopt;
@@ -349,6 +350,7 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
     case ConversionKind::ToString: {
       const Type* st = tt_->string_type(80, tk == TypeKind::WString);
       if (fk == TypeKind::Bool) return native(Native::BOOL_TO_S, st, {s}, 80);
+      if (fk == TypeKind::LTime && from->unsigned_count) return native(Native::LTIME_U_TO_S, st, {s}, 80);
       if (fk == TypeKind::Time || fk == TypeKind::LTime) return native(Native::TIME_TO_S, st, {s}, 80);
       if (fk == TypeKind::Date) return native(Native::DATE_TO_S, st, {s}, 80);
       if (fk == TypeKind::TimeOfDay) return native(Native::TOD_TO_S, st, {s}, 80);
@@ -394,15 +396,17 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
         emit(Op::DIV_F64, {d, f, konst(F64, ConstV{ConstV::K::Real, 0, static_cast<double>(from_unit), {}}, c.loc)});
         return slot_val(to, convert(d, F64, to));
       }
-      return slot_val(to, convert(x, I64, to));
+      // An unsigned LTIME (CODESYS) converts as the ULINT count it is.
+      return slot_val(to, convert(x, from->unsigned_count ? elem(TypeKind::ULInt) : I64, to));
     }
     case ConversionKind::NumberToTime: {
       if (from->is_real()) {
         Slot f = convert(s, from, F64);
         Slot d = temp(8, 8);
         emit(Op::MUL_F64, {d, f, konst(F64, ConstV{ConstV::K::Real, 0, static_cast<double>(to_unit), {}}, c.loc)});
-        return slot_val(to, convert(d, F64, I64));
+        return slot_val(to, convert(d, F64, to->unsigned_count ? elem(TypeKind::ULInt) : I64));
       }
+      if (to->unsigned_count) return slot_val(to, convert(s, from, elem(TypeKind::ULInt)));  // ULINT_TO_LTIME: the count
       Slot x = convert(s, from, I64);
       return slot_val(to, to_unit != 1 ? mul(x, to_unit, Op::MUL_I8) : x);
     }

@@ -88,7 +88,8 @@ Op mov_op(uint32_t size) {
 ValueKind value_kind(const Type* t) {
   switch (t->kind) {
     case TypeKind::Bool: return ValueKind::Bool;
-    case TypeKind::Time: case TypeKind::LTime: return ValueKind::Time;
+    case TypeKind::LTime: return t->unsigned_count ? ValueKind::UTime : ValueKind::Time;
+    case TypeKind::Time: return ValueKind::Time;
     case TypeKind::Date: return ValueKind::Date;
     case TypeKind::TimeOfDay: return ValueKind::Tod;
     case TypeKind::DateTime: return ValueKind::Dt;
@@ -519,6 +520,7 @@ void Compiler::start_program() {
   app_ = owned_.get();
   app_->types = std::make_unique<TypeTable>();
   tt_ = app_->types.get();
+  if (opt_.dialect == Dialect::Codesys) tt_->make_ltime_unsigned();
   null_type_ = tt_->null_ref();
   for (size_t i = 0; i < sm_.size(); ++i) add_file_path(*app_, static_cast<uint32_t>(i));
   alloc(16, 16);  // address 0 stays invalid: it is the null reference

@@ -531,7 +531,16 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
         case LiteralKind::Real: c.k = ConstV::K::Real; c.r = l.real_value; return c;
         case LiteralKind::Bool: c.k = ConstV::K::Bool; c.i = l.int_value ? 1 : 0; return c;
         case LiteralKind::String: case LiteralKind::WString: c.k = ConstV::K::Str; c.s = l.str_value; return c;
-        default: c.k = ConstV::K::Int; c.i = l.time_ns; return c;
+        default:
+          if (l.beyond_signed && opt_.dialect != Dialect::Codesys) {
+            if (report)
+              diags_.error("ST241", e.loc, "an LTIME beyond LTIME#106751d23h47m16s854ms775us807ns is CODESYS, not IEC 61131-3 "
+                                           "(whose LTIME is signed): use --dialect codesys, where LTIME is unsigned up to 2^64 - 1 ns");
+            return std::nullopt;
+          }
+          c.k = ConstV::K::Int;
+          c.i = l.time_ns;
+          return c;
       }
     }
     case ExprKind::EnumLiteral: {

@@ -361,9 +361,9 @@ Val Compiler::literal(const LiteralExpr& l, const Type* expected) {
       v.type = tt_->string_type(std::max<uint32_t>(1, static_cast<uint32_t>(l.str_value.size())), l.lit == LiteralKind::WString);
       return v;
     case LiteralKind::Time: v.type = elem(l.is_long ? TypeKind::LTime : TypeKind::Time); return v;
-    case LiteralKind::Date: v.type = elem(TypeKind::Date); return v;
-    case LiteralKind::TimeOfDay: v.type = elem(TypeKind::TimeOfDay); return v;
-    case LiteralKind::DateTime: v.type = elem(TypeKind::DateTime); return v;
+    case LiteralKind::Date: v.type = l.is_long ? tt_->long_date(TypeKind::Date) : elem(TypeKind::Date); return v;
+    case LiteralKind::TimeOfDay: v.type = l.is_long ? tt_->long_date(TypeKind::TimeOfDay) : elem(TypeKind::TimeOfDay); return v;
+    case LiteralKind::DateTime: v.type = l.is_long ? tt_->long_date(TypeKind::DateTime) : elem(TypeKind::DateTime); return v;
   }
   (void)expected;
   return v;
@@ -808,11 +808,13 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     TypeKind lk = lt->kind, rk = rt->kind;
     auto is_dur = [](TypeKind k) { return k == TypeKind::Time || k == TypeKind::LTime; };
     const Type* result = nullptr;
+    // CODESYS's LTIME counts unsigned: compared and divided as a ULINT (sums are the same bits).
+    const Type* wide = lt->unsigned_count || rt->unsigned_count ? elem(TypeKind::ULInt) : elem(TypeKind::LInt);
     if (is_cmp(e.op)) {
       if (lk != rk && !(is_dur(lk) && is_dur(rk))) return op_error();
-      Slot a = operand(l, lt), b = operand(r, lt);
+      Slot a = operand(l, wide->kind == TypeKind::ULInt ? wide : lt), b = operand(r, wide->kind == TypeKind::ULInt ? wide : lt);
       static const Op kCmp[] = {Op::LT_I8, Op::GT_I8, Op::LE_I8, Op::GE_I8, Op::EQ_I8, Op::NE_I8};
-      return emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], elem(TypeKind::LInt), a, b, elem(TypeKind::Bool));
+      return emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], wide, a, b, elem(TypeKind::Bool));
     }
     if (e.op == BinaryOp::Add) {
       if (is_dur(lk) && is_dur(rk)) result = lk == TypeKind::LTime || rk == TypeKind::LTime ? elem(TypeKind::LTime) : elem(TypeKind::Time);
@@ -829,16 +831,16 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     }
     if ((e.op == BinaryOp::Mul || e.op == BinaryOp::Div) && is_dur(lk) && (rt->is_numeric() || (!r.type && r.is_const))) {
       if (rt->is_real() || (r.is_const && r.c.k == ConstV::K::Real)) {
-        Slot a = convert(operand(l, elem(TypeKind::LInt)), elem(TypeKind::LInt), elem(TypeKind::LReal));
+        Slot a = convert(operand(l, wide), wide, elem(TypeKind::LReal));
         Slot b = operand(r, elem(TypeKind::LReal));
         Val x = emit_bin(e.op == BinaryOp::Mul ? Op::MUL_I8 : Op::DIV_I8, elem(TypeKind::LReal), a, b, elem(TypeKind::LReal));
         Val out;
         out.type = lt;
-        out.slot = convert(x.slot, elem(TypeKind::LReal), elem(TypeKind::LInt));
+        out.slot = convert(x.slot, elem(TypeKind::LReal), wide);
         return out;
       }
-      Slot a = operand(l, elem(TypeKind::LInt)), b = operand(r, elem(TypeKind::LInt));
-      return emit_bin(e.op == BinaryOp::Mul ? Op::MUL_I8 : Op::DIV_I8, elem(TypeKind::LInt), a, b, lt);
+      Slot a = operand(l, wide), b = operand(r, wide);
+      return emit_bin(e.op == BinaryOp::Mul ? Op::MUL_I8 : Op::DIV_I8, wide, a, b, lt);
     }
     if (e.op == BinaryOp::Mul && is_dur(rk) && lt->is_integer()) {
       return emit_bin(Op::MUL_I8, elem(TypeKind::LInt), operand(l, elem(TypeKind::LInt)), operand(r, elem(TypeKind::LInt)), rt);

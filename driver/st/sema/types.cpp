@@ -53,6 +53,14 @@ TypeTable::TypeTable() {
     elementary_[static_cast<size_t>(e.kind)] = t.get();
     owned_.push_back(std::move(t));
   }
+  const std::pair<TypeKind, const char*> kLong[] = {{TypeKind::Date, "LDATE"}, {TypeKind::TimeOfDay, "LTOD"}, {TypeKind::DateTime, "LDT"}};
+  for (size_t i = 0; i < 3; ++i) {
+    auto t = std::make_unique<Type>(*elementary(kLong[i].first));
+    t->name = kLong[i].second;
+    t->long_date = true;
+    long_dates_[i] = t.get();
+    owned_.push_back(std::move(t));
+  }
   Type* n = make(TypeKind::Ref, "NULL");
   n->size = 4;
   n->align = 4;
@@ -68,8 +76,17 @@ const Type* TypeTable::by_name(std::string_view name) const {
     if (c == e.name) return elementary(e.kind);
   }
   for (const auto& a : kAliases)
-    if (c == a.name) return elementary(a.kind);
+    if (c == a.name) return c[0] == 'L' ? long_date(a.kind) : elementary(a.kind);
   return nullptr;
+}
+
+const Type* TypeTable::long_date(TypeKind k) const {
+  switch (k) {
+    case TypeKind::Date: return long_dates_[0];
+    case TypeKind::TimeOfDay: return long_dates_[1];
+    case TypeKind::DateTime: return long_dates_[2];
+    default: return elementary(k);
+  }
 }
 
 const Type* TypeTable::string_type(uint32_t len, bool wide) {
@@ -134,7 +151,8 @@ Storage Type::storage() const {
     case TypeKind::SInt: return Storage::I8;
     case TypeKind::Int: return Storage::I16;
     case TypeKind::DInt: return Storage::I32;
-    case TypeKind::LInt: case TypeKind::Time: case TypeKind::LTime: case TypeKind::Date:
+    case TypeKind::LTime: return unsigned_count ? Storage::U64 : Storage::I64;
+    case TypeKind::LInt: case TypeKind::Time: case TypeKind::Date:
     case TypeKind::TimeOfDay: case TypeKind::DateTime: return Storage::I64;
     case TypeKind::UInt: case TypeKind::Word: return Storage::U16;
     case TypeKind::UDInt: case TypeKind::DWord: case TypeKind::Ref: case TypeKind::Interface:

@@ -55,6 +55,12 @@ struct Type {
   // ARRAY[*] (only a VAR_IN_OUT's type): the bounds are the argument's, known at run time
   // from the in-out's slot (address, then LOWER/UPPER per dimension); dims holds zeros.
   bool open = false;
+  // LTIME under --dialect codesys: unsigned 64-bit nanoseconds (CODESYS, TwinCAT); IEC's is
+  // signed (negative durations exist).
+  bool unsigned_count = false;
+  // LDATE, LTOD, LDT: the values of DATE, TOD and DT (plcfi holds those in ns already),
+  // counted in nanoseconds when converted to and from numbers (IEC 61131-3, CODESYS).
+  bool long_date = false;
   // Struct: members.
   std::vector<Field> fields;
   bool is_union = false;  // UNION (CODESYS): every field at offset 0, the size of the largest
@@ -93,6 +99,12 @@ class TypeTable {
  public:
   TypeTable();
   const Type* elementary(TypeKind k) const { return elementary_[static_cast<size_t>(k)]; }
+  // LDATE, LTOD or LDT for k = Date, TimeOfDay or DateTime (see Type::long_date).
+  const Type* long_date(TypeKind k) const;
+  // LTIME counts unsigned (the CODESYS dialect); before any type uses it.
+  void make_ltime_unsigned() {  // the table owns its elementary types: they are its to change
+    const_cast<Type*>(elementary_[static_cast<size_t>(TypeKind::LTime)])->unsigned_count = true;
+  }
   const Type* by_name(std::string_view name) const;  // elementary names only (INT, TIME, ...)
   const Type* string_type(uint32_t len, bool wide);
   const Type* ref_to(const Type* target);
@@ -103,6 +115,7 @@ class TypeTable {
 
  private:
   std::vector<std::unique_ptr<Type>> owned_;
+  const Type* long_dates_[3] = {};  // LDATE, LTOD, LDT
   std::vector<const Type*> elementary_;
   const Type* null_ = nullptr;
 };

@@ -75,6 +75,7 @@ struct LiteralExpr : Expr {
   std::string str_value;    // decoded ($ escapes resolved) for String/WString
   int64_t time_ns = 0;      // Time: duration; Date/TimeOfDay/DateTime: ns since 1970-01-01 / midnight
   bool is_long = false;     // LTIME#, LDATE#, ... forms
+  bool beyond_signed = false;  // LTIME# above INT64_MAX (time_ns: the unsigned bits; CODESYS only)
 };
 
 struct EnumLiteralExpr : Expr {

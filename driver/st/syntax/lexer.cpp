@@ -796,6 +796,7 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
   };
 
   int64_t value = 0;
+  bool beyond_signed = false;  // an LTIME# above INT64_MAX (value holds its bits)
   LiteralKind lit = LiteralKind::Time;
   // Nanoseconds since the epoch in 64 bits reach from 1677 to 2262.
   auto date_ns = [&](int64_t days, int64_t tod) {
@@ -811,9 +812,13 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
     size_t end = pos_;
     if (end < text_.size() && (text_[end] == '-' || text_[end] == '+')) ++end;
     while (end < text_.size() && (is_ident_char(text_[end]) || text_[end] == '.')) ++end;
-    const common::DurationParse d = common::parse_duration_body(text_.substr(pos_, end - pos_));
+    // LTIME# reads up to 2^64 - 1 ns (CODESYS's unsigned LTIME); the compiler decides
+    // whether the dialect has such values.
+    const std::string_view body = text_.substr(pos_, end - pos_);
+    const common::DurationParse d = is_long ? common::parse_unsigned_duration_body(body) : common::parse_duration_body(body);
     if (d.ok()) value = d.ns;
     else fail(pos_ + d.error_at, d.error);
+    beyond_signed = d.ok() && d.beyond_signed;
     pos_ = end;
     lit = LiteralKind::Time;
   } else if (kind == TimePrefix::Date) {
@@ -841,6 +846,7 @@ Token Lexer::lex_time_literal(size_t begin, std::string_view prefix) {
   tok.lit = lit;
   tok.time_ns = ok ? value : 0;
   tok.is_long = is_long;
+  tok.beyond_signed = ok && beyond_signed;
   tok.prefix = prefix;
   if (!ok) {
     const bool duration = kind == TimePrefix::Duration;

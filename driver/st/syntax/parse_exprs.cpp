@@ -221,6 +221,7 @@ std::unique_ptr<LiteralExpr> Parser::literal_from(const Token& t) {
       lit->lit = t.lit;
       lit->time_ns = t.time_ns;
       lit->is_long = t.is_long;
+      lit->beyond_signed = t.beyond_signed;
       lit->type_prefix = std::string(t.prefix);
       break;
     default: break;

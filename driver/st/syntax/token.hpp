@@ -132,6 +132,7 @@ struct Token {
   std::string str_value;
   int64_t time_ns = 0;
   bool is_long = false;
+  bool beyond_signed = false;  // LTIME# above INT64_MAX: time_ns holds the unsigned bits
   std::string_view prefix;  // TimeLit: "T", "TIME", "LTIME", "DT", ... as written
 
   // DirectAddr payload.

@@ -123,15 +123,11 @@ void bool_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t
 
 }  // namespace
 
-std::string duration_literal(int64_t ns) {
-  std::string out = "T#";
-  if (ns < 0) {
-    out += '-';
-    ns = -ns;
-  }
+namespace {
+std::string duration_text(std::string out, uint64_t ns) {
   if (ns == 0) return out + "0ms";
   struct Unit {
-    int64_t ns;
+    uint64_t ns;
     const char* name;
   };
   static constexpr Unit kUnits[] = {{86'400'000'000'000, "d"}, {3'600'000'000'000, "h"}, {60'000'000'000, "m"},
@@ -144,6 +140,17 @@ std::string duration_literal(int64_t ns) {
     }
   }
   return out;
+}
+}  // namespace
+
+std::string unsigned_duration_literal(uint64_t ns) {
+  return duration_text(ns > static_cast<uint64_t>(INT64_MAX) ? "LTIME#" : "T#", ns);
+}
+
+std::string duration_literal(int64_t ns) {
+  // The magnitude of a negative one (INT64_MIN too) is negated in unsigned arithmetic.
+  if (ns < 0) return duration_text("T#-", uint64_t{0} - static_cast<uint64_t>(ns));
+  return duration_text("T#", static_cast<uint64_t>(ns));
 }
 namespace {
 void civil(int64_t days, int* y, unsigned* m, unsigned* d) {  // days since 1970-01-01
@@ -182,6 +189,9 @@ std::string dt_literal(int64_t ns) { return "DT#" + date_part(ns) + "-" + tod_pa
 
 namespace {
 void time_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, duration_literal(load_as<int64_t>(b))); }
+void ltime_u_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  put(a, cap, unsigned_duration_literal(load_as<uint64_t>(b)));
+}
 void date_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, date_literal(load_as<int64_t>(b))); }
 void tod_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, tod_literal(load_as<int64_t>(b))); }
 void dt_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, dt_literal(load_as<int64_t>(b))); }
@@ -330,6 +340,7 @@ constexpr Entry kNatives[] = {
     {mem_cpy, "MEMCPY"}, {mem_move, "MEMMOVE"}, {mem_set, "MEMSET"}, {mem_cmp, "MEMCMP"},
     {adslog_str, "ADSLOGSTR"}, {adslog_dint, "ADSLOGDINT"}, {adslog_lreal, "ADSLOGLREAL"},
     {task_index, "GETCURTASKINDEX"},
+    {ltime_u_to_s, "LTIME_TO_STRING"},
 };
 static_assert(sizeof(kNatives) / sizeof(kNatives[0]) == static_cast<size_t>(Native::Count_));
 

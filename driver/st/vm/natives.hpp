@@ -28,6 +28,7 @@ enum class Native : uint32_t {
   // string; d: the argument (STRING, DINT, LREAL). The message goes to Machine::log().
   ADSLOG_STR, ADSLOG_DINT, ADSLOG_LREAL,
   TASK_INDEX,              // a: BYTE := the 1-based index of the running task
+  LTIME_U_TO_S,            // LTIME_TO_STRING of an unsigned LTIME (--dialect codesys)
   Count_
 };
 
@@ -40,6 +41,8 @@ inline bool native_traps(uint32_t id) {
 // DATE, TIME_OF_DAY and DATE_AND_TIME since 1970-01-01 / midnight): T#1h2m, D#2024-03-01,
 // TOD#01:00:00.250, DT#2024-03-01-01:00:00. What messages, --print and traces show.
 std::string duration_literal(int64_t ns);
+// An unsigned LTIME (CODESYS): T#... up to INT64_MAX, LTIME#... above (no TIME holds it).
+std::string unsigned_duration_literal(uint64_t ns);
 std::string date_literal(int64_t ns);
 std::string tod_literal(int64_t ns);
 std::string dt_literal(int64_t ns);

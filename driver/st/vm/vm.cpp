@@ -899,6 +899,12 @@ std::string format_value(ValueKind k, const uint8_t* p) {
       if (ns % 1'000'000 == 0) return fmt::format("T#{}ms", ns / 1'000'000);
       return fmt::format("T#{}ns", ns);
     }
+    case ValueKind::UTime: {  // above INT64_MAX no TIME holds it: LTIME#
+      uint64_t ns = ld<uint64_t>(p);
+      const char* prefix = ns > static_cast<uint64_t>(INT64_MAX) ? "LTIME#" : "T#";
+      if (ns % 1'000'000 == 0) return fmt::format("{}{}ms", prefix, ns / 1'000'000);
+      return fmt::format("{}{}ns", prefix, ns);
+    }
     case ValueKind::Date: return date_literal(ld<int64_t>(p));
     case ValueKind::Tod: return tod_literal(ld<int64_t>(p));
     case ValueKind::Dt: return dt_literal(ld<int64_t>(p));
@@ -923,7 +929,7 @@ int compare(ValueKind k, const uint8_t* a, const uint8_t* b) {
     case ValueKind::Dt: case ValueKind::Enum: return cmp3<int64_t>(a, b);
     case ValueKind::U16: return cmp3<uint16_t>(a, b);
     case ValueKind::U32: case ValueKind::Ref: return cmp3<uint32_t>(a, b);
-    case ValueKind::U64: return cmp3<uint64_t>(a, b);
+    case ValueKind::U64: case ValueKind::UTime: return cmp3<uint64_t>(a, b);
     case ValueKind::F32: return cmp3<float>(a, b);
     case ValueKind::F64: return cmp3<double>(a, b);
     case ValueKind::String: {
