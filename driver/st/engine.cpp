@@ -124,8 +124,22 @@ std::string tc2_system_library(const SourceManager& sm, const std::vector<uint32
 // the rest needs is missing to say anything reliable.
 void check_the_rest(Build& b, const CompileOptions& opt) {
   auto before = [](SourceLoc a, SourceLoc c) { return std::tie(a.line, a.col) < std::tie(c.line, c.col); };
+  // Errors are reported where the user's file has them: a POU imported from XML (TwinCAT,
+  // PLCopen) is compared there too, from its declaration on.
+  auto at = [&](SourceLoc l) { return b.sm.origin(l); };
   auto holds = [&](const Pou& p, SourceLoc l) {
-    return l.file == p.loc.file && !before(l, p.loc) && p.end_loc.valid() && !before(p.end_loc, l);
+    const SourceLoc start = at(p.loc), end = at(p.end_loc);
+    if (l.file != start.file || before(l, start)) return false;
+    if (p.end_loc.valid() && end.file == start.file && !before(end, start)) return !before(end, l);
+    // An end the importer wrote (at the XML element, before the declaration): the POU
+    // reaches to the next one in the same file (its body in LD or SFC, say).
+    for (const auto& u : b.units)
+      for (const auto& q : u->pous)
+        if (q && q.get() != &p) {
+          const SourceLoc next = at(q->loc);
+          if (next.file == start.file && before(start, next) && !before(l, next)) return false;
+        }
+    return true;
   };
   std::vector<SourceLoc> errors;
   for (const Diagnostic& d : b.diags.all())
