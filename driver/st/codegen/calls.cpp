@@ -289,6 +289,7 @@ bool Compiler::enabled_call(const CallExpr& c, const AssignStmt* assignment) {
     else call(c, true);
     for (auto it = held.rbegin(); it != held.rend(); ++it)
       args.insert(args.begin() + static_cast<std::ptrdiff_t>(it->first), std::move(it->second));
+    if (eno) eno = enable_arg(c, true);  // the element back in its place, not the old pointer
   }
   bind(skip);
   if (eno && eno->value) {
