@@ -73,7 +73,7 @@ void Runtime::stop(const std::string& reason) {
 bool Runtime::run_due_tasks(std::string* stop_reason) {
   bool ok = true;
   schedule_.for_each_due(scans_, [&](const ScheduledTask& t) {
-    machine_.set_task_index(t.index);
+    schedule_.begin_task(machine_, t);
     for (size_t pi : t.programs) {
       if (!ok) return;
       const auto& inst = app_->programs[pi];

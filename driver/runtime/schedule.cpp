@@ -22,7 +22,7 @@ bool Schedule::from_configuration(const st::Application& app, std::string* err) 
     *err = "the configuration has no task with a program";
     return false;
   }
-  finish();
+  finish(app);
   return true;
 }
 
@@ -48,14 +48,40 @@ bool Schedule::single_program(const st::Application& app, const std::string& pro
     return false;
   }
   tasks_.push_back(ScheduledTask{"cycle", cycle_ns, 0, match, 1});
-  finish();
+  finish(app);
   return true;
 }
 
-void Schedule::finish() {
+void Schedule::finish(const st::Application& app) {
   tick_ns_ = 0;
   for (const auto& t : tasks_) tick_ns_ = std::gcd(tick_ns_, t.interval_ns);
   std::stable_sort(tasks_.begin(), tasks_.end(), [](const auto& a, const auto& b) { return a.priority < b.priority; });
+  // TwinCAT's _TaskInfo (Tc2_System), where the program names it.
+  task_info_.assign(tasks_.size(), std::nullopt);
+  std::string err;
+  if (!st::resolve(app, "_TaskInfo[1].CycleCount", &err)) return;
+  for (size_t i = 0; i < tasks_.size(); ++i) {
+    const std::string at = fmt::format("_TaskInfo[{}].", tasks_[i].index);
+    auto slot = [&](const char* field) { return st::resolve(app, at + field, &err); };
+    auto ct = slot("CycleTime"), pr = slot("Priority"), cc = slot("CycleCount"), fc = slot("FirstCycle"), tn = slot("TaskName");
+    if (ct && pr && cc && fc && tn) task_info_[i] = TaskInfoSlots{*ct, *pr, *cc, *fc, *tn};
+  }
+}
+
+void Schedule::begin_task(st::Machine& m, const ScheduledTask& t) const {
+  m.set_task_index(t.index);
+  const auto i = static_cast<size_t>(&t - tasks_.data());
+  if (i >= task_info_.size() || !task_info_[i]) return;
+  const TaskInfoSlots& s = *task_info_[i];
+  const int64_t count = st::read_int(m, s.cycle_count);
+  st::write_int(m, s.cycle_count, count + 1);
+  st::write_bool(m, s.first_cycle, count == 0);
+  if (count == 0) {  // after a restart: the task's settings
+    std::string err;
+    st::write_int(m, s.cycle_time, t.interval_ns / 100);
+    st::write_int(m, s.priority, t.priority);
+    st::write_text(m, s.task_name, "'" + t.name + "'", &err);
+  }
 }
 
 bool parse_duration(const std::string& text, int64_t* ns, std::string* err) {
@@ -72,7 +98,7 @@ bool parse_duration(const std::string& text, int64_t* ns, std::string* err) {
 bool Schedule::run_due(const st::Application& app, st::Machine& m, uint64_t n, std::string* trap) const {
   bool ok = true;
   for_each_due(n, [&](const ScheduledTask& t) {
-    m.set_task_index(t.index);
+    begin_task(m, t);
     for (size_t pi : t.programs) {
       if (!ok) return;
       const auto& inst = app.programs[pi];

@@ -4,9 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "engine.hpp"
 #include "vm/program.hpp"
 #include "vm/vm.hpp"
 
@@ -38,11 +40,21 @@ class Schedule {
   // Calls the programs of the tasks due at base tick n on m, in order, until one traps:
   // then false, with *trap describing it ("... (program Main, cycle 12)").
   bool run_due(const st::Application& app, st::Machine& m, uint64_t n, std::string* trap) const;
+  // Before a task's programs run: the task index GETCURTASKINDEX gives, and, where the
+  // program uses TwinCAT's _TaskInfo, its entry for the task: CycleTime (100 ns units),
+  // Priority, TaskName, CycleCount (this cycle's number, from 1 after every restart) and
+  // FirstCycle (TRUE in the first). LastExecTime stays 0: the scan takes no time in
+  // virtual time, and real-time runs measure it elsewhere.
+  void begin_task(st::Machine& m, const ScheduledTask& t) const;
 
  private:
-  void finish();
+  void finish(const st::Application& app);
   int64_t tick_ns_ = 0;
   std::vector<ScheduledTask> tasks_;
+  struct TaskInfoSlots {
+    st::VarHandle cycle_time, priority, cycle_count, first_cycle, task_name;
+  };
+  std::vector<std::optional<TaskInfoSlots>> task_info_;  // per task, where _TaskInfo holds it
 };
 
 // Parses "10ms", "1s", "500us", "2m", "1h30m", "T#10ms" into nanoseconds with the one

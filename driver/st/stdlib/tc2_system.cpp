@@ -48,6 +48,19 @@ const std::vector<Tc2Item>& tc2_system_items() {
        "cpuCntLoDW := ULINT_TO_UDINT(ticks AND 16#FFFFFFFF);\n"
        "cpuCntHiDW := ULINT_TO_UDINT(SHR(ticks, 32));\nEND_FUNCTION_BLOCK\n",
        nullptr},
+      // The index of the running task, as a function (TwinCAT's usual way to index _TaskInfo).
+      {"GETCURTASKINDEXEX", "FUNCTION GETCURTASKINDEXEX : BYTE\nGETCURTASKINDEXEX := __TASKINDEX();\nEND_FUNCTION\n", nullptr},
+      // What the runtime tells a PLC program about its tasks, one entry per task by its
+      // index (TwinCAT's TwinCAT_SystemInfoVarList). The scheduler (runtime/schedule.cpp)
+      // fills CycleTime, Priority, TaskName, CycleCount and FirstCycle before each cycle
+      // of the task; the rest stays 0 (no TcCOM objects, ADS ports or distributed clocks).
+      {"PlcTaskSystemInfo",
+       "TYPE PlcTaskSystemInfo :\nSTRUCT\n  ObjId : UDINT;\n  CycleTime : UDINT;\n  Priority : UINT;\n  AdsPort : UINT;\n"
+       "  CycleCount : UDINT;\n  DcTaskTime : LINT;\n  LastExecTime : UDINT;\n  FirstCycle : BOOL;\n"
+       "  CycleTimeExceeded : BOOL;\n  InCallAfterOutputUpdate : BOOL;\n  RTViolation : BOOL;\n  TaskName : STRING(63);\n"
+       "END_STRUCT\nEND_TYPE\n",
+       nullptr},
+      {"_TaskInfo", "VAR_GLOBAL _TaskInfo : ARRAY[1..32] OF PlcTaskSystemInfo; END_VAR\n", "PlcTaskSystemInfo"},
       // Calls the counter FB it is given and joins its two halves, as TcUnit uses it.
       {"F_GetCpuCounterAs64bit",
        "FUNCTION F_GetCpuCounterAs64bit : ULINT\nVAR_IN_OUT fbCpuCounter : GETCPUCOUNTER; END_VAR\n"
