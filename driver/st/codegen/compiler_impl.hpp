@@ -388,7 +388,8 @@ class Compiler {
   // ADR(x)) when the variable is initialised, in declaration order: an FB's or PROGRAM's
   // in its init entry (before the FB_init of what it holds), a FUNCTION's or METHOD's on
   // every call, a global's in the application's init routine. Warning ST407 names each.
-  bool runtime_init(const Symbol* v, const VarDecl* d, uint32_t file, bool report);
+  bool runtime_init(const Symbol* v, const VarDecl* d, uint32_t file, bool report, const PouInfo* pou);
+  bool reads_variables(const Expr& e, const PouInfo* pou);  // pou: null for a global's
   const std::vector<const Symbol*>& runtime_inits(PouInfo* p);
   void emit_runtime_inits(const std::vector<const Symbol*>& vars);
   // Calls the init or exit entry of pou on the instance at `at` (a frame or global place).

@@ -12,6 +12,10 @@
 namespace plcfi::st::detail {
 
 namespace {
+constexpr int64_t kMaxCodesysTimeNs = int64_t{0xFFFFFFFF} * 1'000'000;  // T#49d17h2m47s295ms
+}  // namespace
+
+namespace {
 
 template <class T>
 void put(uint8_t* p, T v) {
@@ -538,6 +542,15 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
                                            "(whose LTIME is signed): use --dialect codesys, where LTIME is unsigned up to 2^64 - 1 ns");
             return std::nullopt;
           }
+          // CODESYS's TIME is a 32-bit count of milliseconds: a literal beyond it is an error
+          // there, and here rather than a value the PLC cannot hold.
+          if (l.lit == LiteralKind::Time && !l.is_long && opt_.dialect == Dialect::Codesys &&
+              (l.time_ns > kMaxCodesysTimeNs || l.time_ns < -kMaxCodesysTimeNs)) {
+            if (report)
+              diags_.error("ST008", e.loc, "a TIME holds at most T#49d17h2m47s295ms under --dialect codesys (a 32-bit count "
+                                           "of milliseconds, as on CODESYS and TwinCAT): use an LTIME# literal");
+            return std::nullopt;
+          }
           c.k = ConstV::K::Int;
           c.i = l.time_ns;
           return c;
@@ -908,7 +921,7 @@ void Compiler::declare_globals(const std::vector<VarBlock>& blocks, const std::s
         } else {
           s->where = Where::Abs;
           s->offset = alloc(t->size, t->align);
-          const bool at_run_time = runtime_init(s.get(), &d, file, true);
+          const bool at_run_time = runtime_init(s.get(), &d, file, true, nullptr);
           if (at_run_time) global_runtime_inits_.push_back(s.get());
           write_init(app_->init_image, s->offset, t, at_run_time ? nullptr : d.init.get(), file);
           if (d.retain) app_->retain_ranges.emplace_back(s->offset, t->size);

@@ -72,7 +72,38 @@ bool Compiler::lifecycle_needed(const Type* t, bool exit) {
   return need;
 }
 
-bool Compiler::runtime_init(const Symbol* v, const VarDecl* d, uint32_t file, bool report) {
+bool Compiler::reads_variables(const Expr& e, const PouInfo* pou) {
+  switch (e.kind) {
+    case ExprKind::Name: {
+      const std::string& n = static_cast<const NameExpr&>(e).name.text;
+      if (const Symbol* s = pou ? pou->find_var(n) : nullptr) return !s->constant;
+      auto g = globals_.find(canon(n));
+      return g != globals_.end() && !g->second->constant;
+    }
+    case ExprKind::Call:
+    case ExprKind::Deref: return true;  // ADR(x), a function's value, p^: known when run
+    case ExprKind::Member: return reads_variables(*static_cast<const MemberExpr&>(e).base, pou);
+    case ExprKind::Index: {
+      const auto& ix = static_cast<const IndexExpr&>(e);
+      for (const auto& i : ix.indices)
+        if (i && reads_variables(*i, pou)) return true;
+      return reads_variables(*ix.base, pou);
+    }
+    case ExprKind::Unary: return reads_variables(*static_cast<const UnaryExpr&>(e).operand, pou);
+    case ExprKind::Binary: {
+      const Expr* cur = &e;  // iterative over the left spine of long chains
+      while (cur->kind == ExprKind::Binary) {
+        const auto& b = static_cast<const BinaryExpr&>(*cur);
+        if (reads_variables(*b.rhs, pou)) return true;
+        cur = b.lhs.get();
+      }
+      return reads_variables(*cur, pou);
+    }
+    default: return false;
+  }
+}
+
+bool Compiler::runtime_init(const Symbol* v, const VarDecl* d, uint32_t file, bool report, const PouInfo* pou) {
   // RETAIN variables keep their value over a warm restart: their initial value stays a constant.
   if (opt_.dialect != Dialect::Codesys || !d || !d->init || !v || !v->type || v->constant || v->retain) return false;
   const Expr& init = *d->init;
@@ -81,6 +112,9 @@ bool Compiler::runtime_init(const Symbol* v, const VarDecl* d, uint32_t file, bo
   if (v->section == VarSection::InOut || v->section == VarSection::External) return false;
   if (v->type->kind == TypeKind::Enum && init.kind == ExprKind::Name) return false;  // a value of the type
   if (const_eval(init, file, false)) return false;
+  // Not a constant because it reads variables or calls (ADR): otherwise the expression is
+  // wrong, and write_init reports why.
+  if (!reads_variables(init, pou)) return false;
   if (report)
     diags_.warning("ST407", init.loc, "the initial value of '" + v->name +
                                          "' is not a constant expression: computed when the variable is initialised, "
@@ -95,7 +129,7 @@ const std::vector<const Symbol*>& Compiler::runtime_inits(PouInfo* p) {
   // A FUNCTION's inputs take their defaults where a call leaves them out: constants only.
   for (const auto& v : p->vars)
     if (v->where == Where::Frame && !(p->kind == PouKind::Function && v->section == VarSection::Input) &&
-        runtime_init(v.get(), decl_of(v.get()), p->file, true))
+        runtime_init(v.get(), decl_of(v.get()), p->file, true, p))
       out.push_back(v.get());
   return out;
 }
