@@ -510,15 +510,27 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
 
 bool Compiler::open_bound(const Place& arr, size_t dim, bool upper, SourceLoc loc, Place* out) {
   const Symbol* s = arr.sym;
+  const uint32_t at = 4 + 8 * static_cast<uint32_t>(dim) + (upper ? 4 : 0);
+  // A METHOD reaching its FB's in-out: the slot is in the instance, through THIS.
+  if (arr.k == Place::K::Ind && s && s->where == Where::This && s->section == VarSection::InOut && s->type &&
+      s->type->kind == TypeKind::Ref && s->type->target && s->type->target->open) {
+    Place b;
+    b.k = Place::K::Ind;
+    b.ptr = Slot{8, SK::Var};
+    b.off = s->offset + at;
+    b.type = elem(TypeKind::DInt);
+    *out = b;
+    return true;
+  }
   if (arr.k != Place::K::Ind || !s || s->where != Where::InOut || !s->type || !s->type->open) {
     diags_.error("ST208", loc, "the bounds of this ARRAY[*] are not known here: only the POU whose VAR_IN_OUT it is "
-                               "can index it or ask LOWER_BOUND/UPPER_BOUND");
+                               "(and its methods) can index it or ask LOWER_BOUND/UPPER_BOUND");
     return false;
   }
   Place b;
   b.k = Place::K::Frame;
   b.sk = SK::Var;
-  b.off = s->offset + 4 + 8 * static_cast<uint32_t>(dim) + (upper ? 4 : 0);
+  b.off = s->offset + at;
   b.type = elem(TypeKind::DInt);
   *out = b;
   return true;
