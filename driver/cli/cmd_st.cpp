@@ -262,40 +262,160 @@ namespace {
 
 // One result line per test, grouped (a test file, a TcUnit suite), and its JUnit case.
 struct TestTally {
-  size_t passed = 0, failed = 0;
+  size_t passed = 0, failed = 0, disabled = 0;
   std::map<std::string, report::JunitSuite> suites;
   std::vector<std::string> order;
   std::string current;
 
+  struct Case {
+    std::string name;
+    enum class Verdict { Pass, Fail, Disabled } verdict = Verdict::Pass;
+    std::vector<std::string> details;  // each shown under a failed test ("file:line:col: message")
+    std::string message;                // JUnit's failure message
+    double seconds = 0;
+    std::vector<std::pair<std::string, std::string>> properties;
+  };
+
   void add(const std::string& group, const std::string& heading, const std::string& name, bool ok,
            const std::string& where, const std::string& message, double seconds) {
+    Case c;
+    c.name = name;
+    c.verdict = ok ? Case::Verdict::Pass : Case::Verdict::Fail;
+    if (!ok) c.details.push_back(where.empty() ? message : where + ": " + message);
+    c.message = message;
+    c.seconds = seconds;
+    add(group, heading, c);
+  }
+
+  void add(const std::string& group, const std::string& heading, const Case& c) {
     if (group != current) {
       current = group;
       std::cout << "[" << heading << "]\n";
     }
-    const std::string detail = where.empty() ? message : where + ": " + message;
-    if (ok) {
-      ++passed;
-      std::cout << "  PASS: " << name << "\n";
-    } else {
-      ++failed;
-      std::cout << "  FAIL: " << name << "\n    " << detail << "\n";
+    report::JunitCase j;
+    j.classname = group;
+    j.name = c.name;
+    j.seconds = c.seconds;
+    j.properties = c.properties;
+    switch (c.verdict) {
+      case Case::Verdict::Pass:
+        ++passed;
+        std::cout << "  PASS: " << c.name << "\n";
+        break;
+      case Case::Verdict::Disabled:
+        ++disabled;
+        std::cout << "  DISABLED: " << c.name << "\n";
+        j.outcome = report::JunitCase::Outcome::Skipped;
+        j.message = "disabled";
+        break;
+      case Case::Verdict::Fail:
+        ++failed;
+        std::cout << "  FAIL: " << c.name << "\n";
+        for (const auto& d : c.details) std::cout << "    " << d << "\n";
+        j.outcome = report::JunitCase::Outcome::Fail;
+        j.message = c.message;
+        for (const auto& d : c.details) j.detail += (j.detail.empty() ? "" : "\n") + d;
+        break;
     }
     if (!suites.count(group)) order.push_back(group);
     auto& s = suites[group];
     s.name = group;
-    report::JunitCase c;
-    c.classname = group;
-    c.name = name;
-    c.seconds = seconds;
-    if (!ok) {
-      c.outcome = report::JunitCase::Outcome::Fail;
-      c.message = message;
-      c.detail = detail;
-    }
-    s.cases.push_back(c);
+    s.cases.push_back(std::move(j));
+  }
+
+  std::string totals() const {
+    return fmt::format("{} passed, {} failed{}", passed, failed, disabled ? fmt::format(", {} disabled", disabled) : "");
   }
 };
+
+// The TcUnit run's results: every suite's tests with their failed assertions, TcUnit's own
+// messages, its summary. Returns false when the run had a problem of its own (a name used
+// twice, more tests or assertions than the parameters allow, TcUnit stopped).
+// TcUnit's extended results (LogExtendedResults), as its log has them after a suite ended.
+void print_tcunit_extended(const rt::TcUnitReport& rep) {
+  for (size_t i = 0; i < rep.suites.size(); ++i) {
+    const auto& s = rep.suites[i];
+    size_t failed = 0;
+    for (const auto& t : s.tests) failed += t.failed;
+    std::cout << fmt::format("| Test suite ID={} '{}'\n| ID={} number of tests={}, number of failed tests={}, duration={}\n", i,
+                             s.path, i, s.tests.size(), failed, rt::tcunit_seconds(s.seconds));
+    for (const auto& t : s.tests) {
+      std::cout << "| Test name=" << t.name << "\n| Test class name=" << s.path << "\n"
+                << fmt::format("| Test status={}, number of asserts={}, duration={}\n",
+                               t.disabled ? "SKIP" : t.failed ? "FAIL" : "PASS", t.asserts, rt::tcunit_seconds(t.seconds));
+      if (!t.message.empty()) std::cout << "| Test assert message=" << t.message << "\n";
+      if (!t.type.empty()) std::cout << "| Test assert type=" << t.type << "\n";
+    }
+  }
+}
+
+bool report_tcunit(const rt::TcUnitReport& rep, const st::Application& app, const st::Build& b, TestTally* tally,
+                   bool extended) {
+  size_t tests = 0, failed = 0;
+  for (const auto& s : rep.suites) {
+    const std::string heading = s.path + " (" + s.type->name + ", " + app.where(b.sm.origin(s.type->loc)) + ")";
+    for (const auto& t : s.tests) {
+      ++tests;
+      failed += t.failed;
+      TestTally::Case c;
+      c.name = t.name;
+      c.seconds = t.seconds;
+      c.verdict = t.disabled ? TestTally::Case::Verdict::Disabled
+                  : t.failed ? TestTally::Case::Verdict::Fail
+                             : TestTally::Case::Verdict::Pass;
+      for (const auto& f : t.failures)
+        c.details.push_back(f.where.valid() ? app.where(b.sm.origin(f.where)) + ": " + f.line : f.line);
+      if (!t.problem.empty())
+        c.details.push_back(t.problem_at.valid() ? app.where(b.sm.origin(t.problem_at)) + ": " + t.problem : t.problem);
+      c.message = !t.failures.empty() ? t.failures.front().line : t.problem;
+      c.properties = {{"status", t.disabled ? "SKIP" : t.failed ? "FAIL" : "PASS"},
+                      {"asserts", std::to_string(t.asserts)}};
+      if (!t.type.empty()) c.properties.emplace_back("type", t.type);  // TcUnit's, for its xUnit file
+      if (t.failed) c.properties.emplace_back("message", !t.message.empty() ? t.message : c.message);
+      tally->add(s.path, heading, c);
+    }
+    if (auto it = tally->suites.find(s.path); it != tally->suites.end())
+      it->second.properties = {{"time", rt::tcunit_seconds(s.seconds)}};
+    if (s.tests.empty())
+      std::cout << "[" << heading << "]\n  "
+                << (s.started ? "(no tests)" : "(not started: RUN_IN_SEQUENCE starts a suite when the one before it is done)")
+                << "\n";
+  }
+  // TcUnit's own messages and the program's (TCUNIT_ADSLOGSTR, ADSLOGSTR), in order; the
+  // failed assertions are shown with their tests above.
+  constexpr size_t kShown = 200;  // a message logged in every cycle of a long run
+  size_t shown = 0, more = 0;
+  for (const auto& l : rep.log) {
+    if (l.text.rfind("FAILED TEST '", 0) == 0) continue;
+    if (shown == kShown) {
+      ++more;
+      continue;
+    }
+    if (shown++ == 0) std::cout << "TcUnit log:\n";
+    std::cout << "  " << l.level << ": " << l.text << "\n";
+  }
+  if (more) std::cout << "  (" << more << " more messages not shown)\n";
+  bool ok = rep.own_errors == 0;
+  for (const auto& s : rep.suites)
+    if (s.registered > rep.max_tests) {
+      ok = false;
+      std::cout << fmt::format("Tests failed because the number of tests ({}) in the test suite '{}' are more than is defined "
+                               "in parameter 'GVL_Param_TcUnit.MaxNumberOfTestsForEachTestSuite' ({}). Please increase this "
+                               "parameter.\n",
+                               s.registered, s.path, rep.max_tests);
+    }
+  if (extended) print_tcunit_extended(rep);
+  std::cout << "| ==========TESTS FINISHED RUNNING==========\n"
+            << "| Test suites: " << rep.suites.size() << "\n"
+            << "| Tests: " << tests << "\n"
+            << "| Successful tests: " << tests - failed << "\n"
+            << "| Failed tests: " << failed << "\n"
+            << "| Duration: " << rt::tcunit_seconds(rep.seconds) << "\n"
+            << "| ======================================\n";
+  std::cout << fmt::format("TcUnit: {} of virtual time, {} cycles{}\n", common::format_duration(rep.virtual_ns), rep.cycles,
+                           rep.timed_out ? "; the time-out ended the run" : rep.aborted ? "; TcUnit stopped" : "");
+  return ok;
+}
 
 // The schedule a TcUnit or --until run scans: the configuration's tasks, or one program.
 bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt::Schedule* sched, const char* why) {
@@ -424,11 +544,13 @@ int cmd_test(const std::vector<std::string>& args) {
       ("timeout", po::value<std::string>()->default_value("10s"), "TcUnit: virtual time the suites get to finish every test (TcUnit's default: 10s); --until: the time the condition gets")
       ("program", po::value<std::string>(), "TcUnit: the program to scan (the one calling TcUnit.RUN()) when there is no task configuration or to run it alone")
       ("cycle-time", po::value<std::string>()->default_value("10ms"), "TcUnit: cycle time of that program")
+      ("tcunit-extended", "TcUnit: print its extended results too (per suite and test: status, number of assertions, duration)")
+      ("xunit", po::value<std::string>(), "TcUnit: write the xUnit XML file TcUnit publishes (testsuites, testcase status PASS/FAIL/SKIP, durations)")
       ("until", po::value<std::string>(), "scan the program until this ST condition holds (e.g. 'PRG_TEST.fbTest.bDone'), then report FB_ASSERT's failed assertions");
   add_coverage_export_options(desc);
   po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--lcov FILE] [--cobertura FILE] [--timeout 10s] [--until EXPR]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--lcov FILE] [--cobertura FILE] [--timeout 10s] [--until EXPR] [--xunit FILE]")) return 0;
   if (!check_coverage_paths(vm, "plcfi test")) return 2;
   int64_t timeout_ns = 0;
   std::string err;
@@ -465,40 +587,34 @@ int cmd_test(const std::vector<std::string>& args) {
     ro.budget = vm["budget"].as<Count>().value;
     for (const auto& r : st::run_tests(app, m, ro)) tally.add(r.file, r.file, r.name, r.passed, r.where, r.message, r.seconds);
   }
+  bool tcunit_ok = true;
   if (tcunit) {
     rt::TcUnitOptions to;
     to.timeout_ns = timeout_ns;
     to.budget = vm["budget"].as<Count>().value;
-    auto start = std::chrono::steady_clock::now();
-    rt::TcUnitReport rep = rt::run_tcunit(app, sched, m, to);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const rt::TcUnitReport rep = rt::run_tcunit(app, sched, m, to);
     if (!rep.program_trap.empty()) std::cerr << rep.program_trap << "\n";
     if (!rep.run_called) {
       std::cerr << "plcfi test: TcUnit.RUN() was not called within " << common::format_duration(to.timeout_ns)
                 << ": call it in the program that holds the suites (e.g. PRG_TEST, called by a task)\n";
       return 1;
     }
-    size_t tests = 0, failed = 0;
-    for (const auto& s : rep.suites) {
-      const std::string heading = s.path + " (" + s.type->name + ", " + app.where(b->sm.origin(s.type->loc)) + ")";
-      for (const auto& t : s.tests) {
-        ++tests;
-        failed += t.failed;
-        const std::string where = t.where.valid() ? app.where(b->sm.origin(t.where)) : "";
-        tally.add(s.path, heading, t.name, !t.failed, where, t.message, seconds / static_cast<double>(s.tests.size()));
+    const size_t first = tally.order.size();
+    tcunit_ok = report_tcunit(rep, app, *b, &tally, vm.count("tcunit-extended") > 0);
+    if (vm.count("xunit")) {
+      std::vector<report::JunitSuite> v;
+      for (size_t i = first; i < tally.order.size(); ++i) v.push_back(tally.suites[tally.order[i]]);
+      if (!report::write_tcunit_xunit(vm["xunit"].as<std::string>(), v, rep.seconds, &err)) {
+        std::cerr << "plcfi test: " << err << "\n";
+        return 2;
       }
-      if (s.tests.empty())
-        std::cout << "[" << heading << "]\n  "
-                  << (s.started ? "(no tests)" : "(not started: RUN_IN_SEQUENCE starts a suite when the one before it is done)")
-                  << "\n";
-      if (s.overflow) std::cout << "  (more than 100 tests in this suite: the rest were not run)\n";
     }
-    std::cout << fmt::format("TcUnit: {} test suites, {} tests, {} successful, {} failed ({} of virtual time, {} cycles{})\n",
-                             rep.suites.size(), tests, tests - failed, failed, common::format_duration(rep.virtual_ns),
-                             rep.cycles, rep.timed_out ? "; the time-out ended the run" : "");
+  } else if (vm.count("xunit")) {
+    std::cerr << "plcfi test: --xunit writes TcUnit's xUnit file: there are no TcUnit suites among the inputs (use --junit)\n";
+    return 2;
   }
   if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
-  std::cout << tally.passed << " passed, " << tally.failed << " failed\n";
+  std::cout << tally.totals() << "\n";
   if (vm.count("junit")) {
     std::vector<report::JunitSuite> v;
     for (const auto& f : tally.order) v.push_back(tally.suites[f]);
@@ -510,7 +626,7 @@ int cmd_test(const std::vector<std::string>& args) {
   if (coverage_export_wanted(vm) &&
       !write_coverage_exports(vm, app, m.hits(), report::coverage_files(*b), "plcfi_test", "plcfi test"))
     return 2;
-  return tally.failed ? 1 : 0;
+  return tally.failed || !tcunit_ok ? 1 : 0;
 }
 
 }  // namespace plcfi::cli

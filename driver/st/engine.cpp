@@ -207,7 +207,10 @@ std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> fi
     if (std::string sys = tc2_system_library(b->sm, files); !sys.empty())
       files.insert(files.begin() + 1, b->sm.add("<Tc2_System>", sys));
   }
-  if (uses_library(b->sm, files, "fb_testsuite")) files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
+  if (uses_library(b->sm, files, "fb_testsuite")) {
+    files.insert(files.begin() + 1, b->sm.add("<TcUnit>/GVL_Param_TcUnit", tcunit_params_source()));
+    files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
+  }
   if (uses_library(b->sm, files, "fb_assert")) files.insert(files.begin() + 1, b->sm.add("<FB_ASSERT>", fb_assert_source()));
   for (uint32_t f : files) {
     if (is_test_file(b->sm, f)) b->tests.push_back(parse_test_file(b->sm, f, b->diags));

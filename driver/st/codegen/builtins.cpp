@@ -276,6 +276,7 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
   // before this, and an unknown one is reported as unknown).
   if (f->late_only() && (!b_->pou || !is_late(b_->pou))) return std::nullopt;
   if (f->codesys_only() && opt_.dialect != Dialect::Codesys) return std::nullopt;
+  if (f->library_only() && (!b_->pou || !b_->pou->is_stdlib)) return std::nullopt;
   if (f->test_only() && !b_->in_test) {
     diags_.error("ST211", c.loc, name + " is only available in TEST, SETUP and TEARDOWN blocks of test files");
     return bad();

@@ -53,6 +53,9 @@ const char* stdlib_source();
 // The TcUnit framework's ST source (FB_TestSuite, RUN), compiled with an application whose
 // sources use it (stdlib/tcunit.cpp).
 const char* tcunit_source();
+// TcUnit's parameter list GVL_Param_TcUnit (loaded as "<TcUnit>/GVL_Param_TcUnit", whose
+// stem is the list's name), with TcUnit's defaults.
+const char* tcunit_params_source();
 // FB_ASSERT (the assertion-FB style of TwinCAT unit tests), compiled with an application
 // whose sources use it (stdlib/tcunit.cpp).
 const char* fb_assert_source();
@@ -81,8 +84,8 @@ SourceLoc unpack_location(int64_t packed);
 // The libraries plcfi brings, loaded under these names: no warnings, mocks, coverage or
 // listing of their own. (Other sources in memory have names in angle brackets too.)
 inline bool is_library_path(const std::string& path) {
-  return path == "<stdlib>" || path == "<TcUnit>" || path == "<FB_ASSERT>" || path == "<Tc2>" ||
-         path == "<Tc2_System>";
+  return path == "<stdlib>" || path == "<TcUnit>" || path == "<TcUnit>/GVL_Param_TcUnit" || path == "<FB_ASSERT>" ||
+         path == "<Tc2>" || path == "<Tc2_System>";
 }
 
 }  // namespace plcfi::st

@@ -574,6 +574,15 @@ std::optional<ConstV> Compiler::const_eval(const Expr& e, uint32_t file, bool re
         return ConstV{ConstV::K::Int, ev->value, 0, {}};
       if (reported) return std::nullopt;
       // A global constant qualified by its list's name: Params.MaxAxes.
+      // And by a library's namespace too: TcUnit.GVL_Param_TcUnit.MaxNumberOfTestSuites.
+      const Expr* list = m.base.get();
+      if (list->kind == ExprKind::Member) {
+        const auto& lib = static_cast<const MemberExpr&>(*list);
+        if (lib.base->kind == ExprKind::Name && !lookup(canon(static_cast<const NameExpr&>(*lib.base).name.text))) {
+          auto it = global_consts_.find(canon(lib.member.text) + "." + canon(m.member.text));
+          if (it != global_consts_.end() && it->second.first->init) return const_eval(*it->second.first->init, it->second.second, report);
+        }
+      }
       if (m.base->kind == ExprKind::Name) {
         auto it = global_consts_.find(canon(static_cast<const NameExpr&>(*m.base).name.text) + "." + canon(m.member.text));
         if (it != global_consts_.end() && it->second.first->init) return const_eval(*it->second.first->init, it->second.second, report);

@@ -53,6 +53,15 @@ std::string tcunit_suffix(const Type* t) {
   }
 }
 
+// The name TcUnit gives a value's type class in AssertEquals (ANY)'s type-mismatch message.
+std::string tcunit_type_class(const Type* t) {
+  switch (t->kind) {
+    case TypeKind::DateTime: return "DATEANDTIME";
+    case TypeKind::TimeOfDay: return "TIMEOFDAY";
+    default: return tcunit_suffix(t);
+  }
+}
+
 bool starts_with_ci(const std::string& s, std::string_view prefix) {
   return s.size() >= prefix.size() && iequals(std::string_view(s).substr(0, prefix.size()), prefix);
 }
@@ -121,20 +130,22 @@ PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
     }
     if (ve.type && va.type && tcunit_suffix(ve.type) != suffix) {
       // TcUnit's AssertEquals (ANY) fails when the two differ in type: the generic method
-      // reports it, with the types' names.
+      // reports it, with TcUnit's names of the type classes.
       auto name_of = [&](const Type* ty) {
         Val s;
         s.type = tt_->string_type(255, false);
         s.is_const = true;
         s.c.k = ConstV::K::Str;
-        s.c.s = ty->name;
+        s.c.s = tcunit_type_class(ty);
         return s;
       };
       preset_[e->value.get()] = name_of(ve.type);
       preset_[a->value.get()] = name_of(va.type);
       return m;
     }
-    PouInfo* typed = m->owner->find_method("AssertEquals_" + suffix);
+    // Two STRINGs: TcUnit's ANY compares their lengths first (its own message).
+    PouInfo* typed = m->owner->find_method(suffix == "STRING" || suffix == "WSTRING" ? "_tcuAnyEquals_" + suffix
+                                                                                     : "AssertEquals_" + suffix);
     if (!typed) {
       diags_.error("ST242", a->loc, "TcUnit has no AssertEquals_" + suffix);
       return nullptr;
@@ -197,7 +208,18 @@ PouInfo* Compiler::tcunit_lowering(const CallExpr& c, PouInfo* m) {
     shape.lo[k] = static_cast<int32_t>(arr[0]->dims[k].lo);
     shape.extent[k] = static_cast<uint32_t>(arr[0]->dims[k].hi - arr[0]->dims[k].lo + 1);
   }
-  shape.elem_size_a = arr[1]->elem->size;  // STRINGs of two lengths
+  shape.elem_size_a = arr[1]->elem->size;
+  shape.style = 1;  // TcUnit's record, indices in each array's own bounds
+  switch (arr[0]->elem->kind) {
+    case TypeKind::Byte: case TypeKind::Word: case TypeKind::DWord: case TypeKind::LWord:
+      shape.hex_digits = arr[0]->elem->size * 2;
+      break;
+    default: break;
+  }
+  for (uint32_t k = 0; k < ndims; ++k) {
+    shape.lo_a[k] = static_cast<int32_t>(arr[1]->dims[k].lo);
+    shape.extent_a[k] = static_cast<uint32_t>(arr[1]->dims[k].hi - arr[1]->dims[k].lo + 1);
+  }
   Slot shape_slot = konst_bytes(&shape, sizeof shape, 4);
   Val diff = native(Native::ARRAY_DIFF, tt_->string_type(255, false), {block, shape_slot}, 255);
   Val unused;

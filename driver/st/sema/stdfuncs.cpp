@@ -64,6 +64,12 @@ StdFunc vendor(std::string_view name, Native n, const char* operands, char resul
   f.result = result;
   return f;
 }
+// A helper of plcfi's built-in libraries (TcUnit), computed by a native helper.
+StdFunc library(std::string_view name, Native n, const char* operands, char result, std::vector<const char*> params) {
+  StdFunc f = vendor(name, n, operands, result, std::move(params));
+  f.flags = kStdLibraryOnly;
+  return f;
+}
 StdFunc temporal(std::string_view name, Temporal t) {
   StdFunc f = fn(name, StdFamily::Temporal, 1, 1, kStdLateOnly);
   f.temporal = t;
@@ -159,6 +165,9 @@ std::vector<StdFunc> make_table() {
       vendor("ADSLOGLREAL", Native::ADSLOG_LREAL, "WSF", 'D', {"msgCtrlMask", "msgFmtStr", "lrealArg"}),
       // The running task's index, read by the library's GETCURTASKINDEX (stdlib/tc2_system.cpp).
       vendor("__TASKINDEX", Native::TASK_INDEX, "", 'Y', {}),
+      // TcUnit's library: an event for its runner, and a message in TcUnit's log.
+      library("__TCUNIT", Native::TCUNIT, "DA", 'D', {"event", "suite"}),
+      library("__TCUNIT_LOG", Native::ADSLOG_STR, "WSS", 'D', {"msgCtrlMask", "msgFmtStr", "strArg"}),
       // TIME(): the scan clock, CODESYS's and TwinCAT's function of that name.
       fn("TIME", F::Now, 0, 0, kStdCodesysOnly),
       temporal("RISING", Temporal::Rising),

@@ -54,6 +54,7 @@ inline constexpr uint8_t kStdExtensible = 1;  // any number of arguments from mi
 inline constexpr uint8_t kStdLateOnly = 2;    // only in units compiled late (monitors); elsewhere unknown
 inline constexpr uint8_t kStdTestOnly = 4;    // only in TEST, SETUP and TEARDOWN blocks (error elsewhere)
 inline constexpr uint8_t kStdCodesysOnly = 8; // a vendor library's, under --dialect codesys; elsewhere unknown
+inline constexpr uint8_t kStdLibraryOnly = 16; // only in plcfi's built-in libraries' POUs (any dialect)
 
 struct StdFunc {
   std::string_view name;  // canonical (upper case)
@@ -80,6 +81,7 @@ struct StdFunc {
   bool late_only() const { return flags & kStdLateOnly; }
   bool test_only() const { return flags & kStdTestOnly; }
   bool codesys_only() const { return flags & kStdCodesysOnly; }
+  bool library_only() const { return flags & kStdLibraryOnly; }
   // The largest argument count, SIZE_MAX when extensible.
   size_t max_count() const { return extensible() ? SIZE_MAX : max_args; }
 };

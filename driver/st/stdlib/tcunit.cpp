@@ -7,15 +7,14 @@
 //   TEST_FINISHED() when done (possibly many cycles later).
 // - RUN() (or RUN_IN_SEQUENCE()), called from the user's test program, counts its calls in
 //   _TcUnitRun/_TcUnitMode; plcfi's TcUnit runner (runtime/tcunit.cpp) then calls the body
-//   of every suite instance once per cycle, after raising the suite's _tcuCycle, until all
-//   tests finished or the time-out, and reads the results from the _tcu* variables.
+//   of every suite instance once per cycle until all tests finished or the time-out.
+// - The library keeps no bookkeeping: each call fills the suite's mailbox and hands it to
+//   the runner through __TCUNIT (stdlib/tcunit_abi.hpp), which applies TcUnit's rules.
+//   An assertion computes its verdict and TcUnit's texts of EXP and ACT here, in ST.
 // - The compiler lowers AssertEquals (ANY) to AssertEquals_<type of Actual>, and
-//   AssertArray*Equals_<T> to a comparison of the two arrays whose finding (a message, or
-//   '' when equal) arrives in Expecteds; it fills the hidden input _tcuAt of every Assert
-//   method with the call's location, so a failure points at the assertion.
-// TcUnit's semantics: a test fails on its first failed assertion (later ones are not
-// reported), assertions after TEST_FINISHED are ignored, a name used by two TESTs in one
-// cycle of a suite is reported.
+//   AssertArray*Equals_<T> to a comparison of the two arrays (of any bounds) whose record
+//   arrives in Expecteds; it fills the hidden input _tcuAt of every Assert method with the
+//   call's location, so a failure points at the assertion.
 //
 // The same file builds FB_ASSERT, the older assertion-FB style of TwinCAT unit tests (see
 // fb_assert_source below): it shares the table of elementary types and their texts.
@@ -50,22 +49,24 @@ const std::vector<Elementary>& elementary() {
       {"UINT", "UINT", "UINT_TO_STRING(@)"},
       {"UDINT", "UDINT", "UDINT_TO_STRING(@)"},
       {"ULINT", "ULINT", "ULINT_TO_STRING(@)"},
-      {"REAL", "REAL", "REAL_TO_STRING(@)", true},
-      {"LREAL", "LREAL", "LREAL_TO_STRING(@)", true},
+      {"REAL", "REAL", "_tcuReal(REAL_TO_STRING(@))", true},
+      {"LREAL", "LREAL", "_tcuReal(LREAL_TO_STRING(@))", true},
       {"TIME", "TIME", "TIME_TO_STRING(@)"},
       {"LTIME", "LTIME", "LTIME_TO_STRING(@)"},
       {"DATE", "DATE", "DATE_TO_STRING(@)"},
       {"TIME_OF_DAY", "TIME_OF_DAY", "TOD_TO_STRING(@)"},
       {"DATE_AND_TIME", "DATE_AND_TIME", "DT_TO_STRING(@)"},
       {"STRING", "STRING(255)", "@"},
+      // TcUnit does not print WSTRINGs (nor does FB_ASSERT here: the ASCII of one).
       {"WSTRING", "WSTRING(255)", "WSTRING_TO_STRING(@)"},
   };
   return v;
 }
 
-// Element types of AssertArrayEquals_<T> (and the 2-d and 3-d forms).
+// Element types of AssertArrayEquals_<T>.
+// TcUnit has these 1-dimensional ones, and 2- and 3-dimensional ones of REAL and LREAL.
 const char* const kArrayTypes[] = {"BOOL", "BYTE", "WORD", "DWORD", "LWORD", "SINT", "INT", "DINT", "LINT",
-                                   "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL", "STRING"};
+                                   "USINT", "UINT", "UDINT", "ULINT", "REAL", "LREAL"};
 
 std::string replace_all(std::string s, const std::string& from, const std::string& to) {
   for (size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size())) s.replace(p, from.size(), to);
@@ -73,6 +74,22 @@ std::string replace_all(std::string s, const std::string& from, const std::strin
 }
 
 std::string assert_equals(const Elementary& e) {
+  if (std::string(e.name) == "WSTRING")  // TcUnit's words; the values tell assertions apart
+    return R"ST(
+METHOD AssertEquals_WSTRING
+VAR_INPUT
+  Expected : WSTRING(255);
+  Actual : WSTRING(255);
+  Message : STRING(255);
+  _tcuAt : LINT;
+END_VAR
+IF _tcuActive() THEN
+  _tcuReportKeyed(Expected = Actual, 'Not possible to print EXP unicode WSTRING value',
+                  'Not possible to print ACT unicode WSTRING value', Message, 'WSTRING', _tcuAt,
+                  CONCAT(CONCAT(WSTRING_TO_STRING(Expected), '$R'), WSTRING_TO_STRING(Actual)));
+END_IF;
+END_METHOD
+)ST";
   std::string text = R"ST(
 METHOD AssertEquals_@N
 VAR_INPUT
@@ -81,37 +98,44 @@ VAR_INPUT
 @D  Message : STRING(255);
   _tcuAt : LINT;
 END_VAR
-IF @CMP THEN
-  _tcuFail(CONCAT(CONCAT('EXP: ', @E), CONCAT(', ACT: ', @A)), Message, _tcuAt);
+IF _tcuActive() THEN
+  _tcuReport(@CMP, @E, @A, Message, '@N', _tcuAt);
 END_IF;
 END_METHOD
 )ST";
   text = replace_all(text, "@D", e.delta ? std::string("  Delta : ") + e.type + ";\n" : "");
-  text = replace_all(text, "@CMP", e.delta ? "ABS(Expected - Actual) > Delta" : "Expected <> Actual");
+  text = replace_all(text, "@CMP", e.delta ? "ABS(Expected - Actual) <= Delta" : "Expected = Actual");
   text = replace_all(text, "@E", replace_all(e.text, "@", "Expected"));
   text = replace_all(text, "@A", replace_all(e.text, "@", "Actual"));
   text = replace_all(text, "@N", e.name);
   return replace_all(text, "@T", e.type);
 }
 
-// The compiler compares the arrays (vm: array_difference) and passes what it found.
+// AssertArray<M>Equals_<N>: the compiler compares the arrays (vm: array_difference, in
+// TcUnit's style) and passes its record (tcunit_abi::kSep-separated) in Expecteds.
 std::string assert_array_equals(const std::string& dims, const std::string& name) {
   bool delta = name == "REAL" || name == "LREAL";
   std::string text = R"ST(
 METHOD AssertArray@MEquals_@N
 VAR_INPUT
-  Expecteds : STRING(255);  (* the difference found ('' when the arrays are equal) *)
+  Expecteds : STRING(255);  (* the comparison's record *)
   Actuals : BOOL;
 @D  Message : STRING(255);
   _tcuAt : LINT;
 END_VAR
-IF Expecteds <> '' THEN
-  _tcuFail(Expecteds, Message, _tcuAt);
+IF NOT _tcuActive() THEN
+  RETURN;
 END_IF;
+_tcuExp := Expecteds;
+_tcuMsg := Message;
+_tcuType := 'Array@T_@N';
+_tcuLoc := _tcuAt;
+__TCUNIT(7, ADR(THIS^));
 END_METHOD
 )ST";
   text = replace_all(text, "@D", delta ? "  Delta : " + name + ";\n" : "");
   text = replace_all(text, "@M", dims);
+  text = replace_all(text, "@T", dims == "2d" ? "2D" : dims == "3d" ? "3D" : "");
   return replace_all(text, "@N", name);
 }
 
@@ -132,11 +156,28 @@ END_FUNCTION
   return replace_all(text, "@F", name);
 }
 
+// WRITE_PROTECTED_<T>(Ptr, Value): a test writes a variable its program cannot (an input
+// AT %I*), through its address.
+std::string write_protected(const Elementary& e) {
+  std::string text = R"ST(
+FUNCTION WRITE_PROTECTED_@N : BOOL
+VAR_INPUT Ptr : POINTER TO @T; Value : @T; END_VAR
+Ptr^ := Value;
+END_FUNCTION
+)ST";
+  text = replace_all(text, "@N", e.name);
+  // TcUnit's strings here are of the default length (STRING is STRING(80)), as the inputs
+  // they write are: a longer type would write past them.
+  const std::string n = e.name;
+  return replace_all(text, "@T", n == "STRING" || n == "WSTRING" ? n : e.type);
+}
+
 std::string build_tcunit() {
   std::string text = hex_function("_tcuHex") + R"ST(
 VAR_GLOBAL
   _TcUnitRun : DINT;   (* calls of RUN / RUN_IN_SEQUENCE since the runner last looked *)
   _TcUnitMode : INT;   (* 1: RUN (suites side by side), 2: RUN_IN_SEQUENCE *)
+  _TcUnitPause : TIME; (* RUN_IN_SEQUENCE's TimeBetweenTestSuitesExecution *)
 END_VAR
 
 FUNCTION RUN : BOOL
@@ -145,143 +186,171 @@ _TcUnitMode := 1;
 RUN := TRUE;
 END_FUNCTION
 
+(* TcUnit's pause between one suite's end and the next one's start. *)
 FUNCTION RUN_IN_SEQUENCE : BOOL
+VAR_INPUT TimeBetweenTestSuitesExecution : TIME := T#0MS; END_VAR
 _TcUnitRun := _TcUnitRun + 1;
+_TcUnitPause := TimeBetweenTestSuitesExecution;
 _TcUnitMode := 2;
 RUN_IN_SEQUENCE := TRUE;
 END_FUNCTION
 
+(* A message in TcUnit's log, in order with its own (plcfi prints both). *)
+FUNCTION TCUNIT_ADSLOGSTR : DINT
+VAR_INPUT msgCtrlMask : DWORD; msgFmtStr : STRING(255); strArg : STRING(255); END_VAR
+TCUNIT_ADSLOGSTR := __TCUNIT_LOG(msgCtrlMask, msgFmtStr, strArg);
+END_FUNCTION
+
+(* TcUnit's REAL and LREAL texts: the shortest that reads back, with a decimal point
+   (-23.0, 0.0, 1234.5), as TcUnit prints them. *)
+FUNCTION _tcuReal : STRING(40)
+VAR_INPUT text : STRING(40); END_VAR
+_tcuReal := text;
+IF FIND(text, '.') = 0 AND FIND(text, 'E') = 0 AND FIND(text, 'e') = 0 AND FIND(text, 'N') = 0 AND FIND(text, 'n') = 0 THEN
+  _tcuReal := CONCAT(text, '.0');
+END_IF;
+END_FUNCTION
+
+(* The characters of a WSTRING (its text here is UTF-8: continuation bytes do not count). *)
+FUNCTION _tcuChars : INT
+VAR_INPUT s : STRING(255); END_VAR
+VAR i : INT; c : STRING(1); END_VAR
+FOR i := 1 TO LEN(s) DO
+  c := MID(s, 1, i);
+  IF c < '$80' OR c > '$BF' THEN
+    _tcuChars := _tcuChars + 1;
+  END_IF;
+END_FOR;
+END_FUNCTION
 
 FUNCTION_BLOCK FB_TestSuite
 VAR
-  _tcuCycle : DINT;      (* raised by the runner before each call of the body *)
-  _tcuCount : INT;       (* tests registered *)
-  _tcuCurrent : INT;     (* the test assertions count for; 0: none *)
-  _tcuOverflow : BOOL;   (* a TEST beyond the 100 a suite holds *)
-  _tcuName : ARRAY[1..100] OF STRING(255);
-  _tcuOrdered : ARRAY[1..100] OF BOOL;
-  _tcuSeen : ARRAY[1..100] OF DINT;      (* the cycle its TEST last ran in *)
-  _tcuFinished : ARRAY[1..100] OF BOOL;
-  _tcuFailed : ARRAY[1..100] OF BOOL;
-  _tcuMessage : ARRAY[1..100] OF STRING(255);
-  _tcuWhere : ARRAY[1..100] OF LINT;     (* the failed assertion's location *)
+  (* The mailbox the runner reads at each __TCUNIT call (stdlib/tcunit_abi.hpp). *)
+  _tcuOk : BOOL;
+  _tcuExp : STRING(255);
+  _tcuAct : STRING(255);
+  _tcuMsg : STRING(255);
+  _tcuKey : STRING(255);
+  _tcuType : STRING(40);
+  _tcuName : STRING(255);
+  _tcuLoc : LINT;
 END_VAR
 
-METHOD PRIVATE _tcuSelect : INT
-VAR_INPUT TestName : STRING(255); Ordered : BOOL; END_VAR
-VAR i : INT; END_VAR
-_tcuCurrent := 0;
-FOR i := 1 TO _tcuCount DO
-  IF _tcuName[i] = TestName THEN
-    IF _tcuSeen[i] = _tcuCycle THEN
-      (* a second TEST of this name in one cycle: two tests share the name *)
-      IF NOT _tcuFailed[i] THEN
-        _tcuFailed[i] := TRUE;
-        _tcuMessage[i] := CONCAT(CONCAT('duplicate test name: two tests in this suite are called ''', TestName), '''');
-        _tcuWhere[i] := 0;
-      END_IF;
-      RETURN;
-    END_IF;
-    _tcuSeen[i] := _tcuCycle;
-    _tcuCurrent := i;
-    _tcuSelect := i;
-    RETURN;
-  END_IF;
-END_FOR;
-IF _tcuCount >= 100 THEN
-  _tcuOverflow := TRUE;
-  RETURN;
-END_IF;
-_tcuCount := _tcuCount + 1;
-_tcuName[_tcuCount] := TestName;
-_tcuOrdered[_tcuCount] := Ordered;
-_tcuSeen[_tcuCount] := _tcuCycle;
-_tcuCurrent := _tcuCount;
-_tcuSelect := _tcuCount;
+METHOD PRIVATE _tcuActive : BOOL
+_tcuActive := __TCUNIT(0, ADR(THIS^)) <> 0;
 END_METHOD
 
-METHOD PRIVATE _tcuFail
-VAR_INPUT Detail : STRING(255); Message : STRING(255); Loc : LINT; END_VAR
-IF _tcuCurrent = 0 THEN
-  RETURN;
-END_IF;
-IF _tcuFinished[_tcuCurrent] OR _tcuFailed[_tcuCurrent] THEN
-  RETURN;
-END_IF;
-_tcuFailed[_tcuCurrent] := TRUE;
-IF Message <> '' THEN
-  _tcuMessage[_tcuCurrent] := CONCAT(CONCAT(Detail, ', MSG: '), Message);
-ELSE
-  _tcuMessage[_tcuCurrent] := Detail;
-END_IF;
-_tcuWhere[_tcuCurrent] := Loc;
+METHOD PRIVATE _tcuReport
+VAR_INPUT Ok : BOOL; Exp : STRING(255); Act : STRING(255); Msg : STRING(255); Typ : STRING(40); Loc : LINT; END_VAR
+_tcuOk := Ok;
+_tcuExp := Exp;
+_tcuAct := Act;
+_tcuMsg := Msg;
+_tcuKey := '';
+_tcuType := Typ;
+_tcuLoc := Loc;
+__TCUNIT(6, ADR(THIS^));
+END_METHOD
+
+METHOD PRIVATE _tcuReportKeyed
+VAR_INPUT Ok : BOOL; Exp : STRING(255); Act : STRING(255); Msg : STRING(255); Typ : STRING(40); Loc : LINT; Key : STRING(255); END_VAR
+_tcuOk := Ok;
+_tcuExp := Exp;
+_tcuAct := Act;
+_tcuMsg := Msg;
+_tcuKey := Key;
+_tcuType := Typ;
+_tcuLoc := Loc;
+__TCUNIT(6, ADR(THIS^));
 END_METHOD
 
 METHOD TEST
 VAR_INPUT TestName : STRING(255); END_VAR
-_tcuSelect(TestName, FALSE);
+_tcuName := TestName;
+__TCUNIT(1, ADR(THIS^));
 END_METHOD
 
 (* TRUE when it is this test's turn: every ordered test registered before it finished. *)
 METHOD TEST_ORDERED : BOOL
 VAR_INPUT TestName : STRING(255); END_VAR
-VAR i, k : INT; END_VAR
-i := _tcuSelect(TestName, TRUE);
-IF i = 0 THEN
-  RETURN;
-END_IF;
-FOR k := 1 TO i - 1 DO
-  IF _tcuOrdered[k] AND NOT _tcuFinished[k] THEN
-    _tcuCurrent := 0;
-    RETURN;
-  END_IF;
-END_FOR;
-TEST_ORDERED := NOT _tcuFinished[i];
+_tcuName := TestName;
+TEST_ORDERED := __TCUNIT(2, ADR(THIS^)) <> 0;
 END_METHOD
 
 METHOD TEST_FINISHED : BOOL
-IF _tcuCurrent > 0 THEN
-  _tcuFinished[_tcuCurrent] := TRUE;
-END_IF;
-TEST_FINISHED := TRUE;
+TEST_FINISHED := __TCUNIT(3, ADR(THIS^)) <> 0;
 END_METHOD
 
 METHOD TEST_FINISHED_NAMED : BOOL
 VAR_INPUT TestName : STRING(255); END_VAR
-VAR i : INT; END_VAR
-FOR i := 1 TO _tcuCount DO
-  IF _tcuName[i] = TestName THEN
-    _tcuFinished[i] := TRUE;
-    TEST_FINISHED_NAMED := TRUE;
-  END_IF;
-END_FOR;
+_tcuName := TestName;
+TEST_FINISHED_NAMED := __TCUNIT(4, ADR(THIS^)) <> 0;
+END_METHOD
+
+METHOD IS_TEST_FINISHED : BOOL
+VAR_INPUT TestName : STRING(255); END_VAR
+_tcuName := TestName;
+IS_TEST_FINISHED := __TCUNIT(5, ADR(THIS^)) <> 0;
 END_METHOD
 
 METHOD AssertTrue
 VAR_INPUT Condition : BOOL; Message : STRING(255); _tcuAt : LINT; END_VAR
-IF NOT Condition THEN
-  _tcuFail('EXP: TRUE, ACT: FALSE', Message, _tcuAt);
+IF _tcuActive() THEN
+  _tcuReport(Condition, 'TRUE', BOOL_TO_STRING(Condition), Message, 'BOOL', _tcuAt);
 END_IF;
 END_METHOD
 
 METHOD AssertFalse
 VAR_INPUT Condition : BOOL; Message : STRING(255); _tcuAt : LINT; END_VAR
-IF Condition THEN
-  _tcuFail('EXP: FALSE, ACT: TRUE', Message, _tcuAt);
+IF _tcuActive() THEN
+  _tcuReport(NOT Condition, 'FALSE', BOOL_TO_STRING(Condition), Message, 'BOOL', _tcuAt);
 END_IF;
 END_METHOD
 
-(* AssertEquals (ANY): the compiler calls AssertEquals_<type of Actual> instead; two
-   different types end here, with their names in Expected and Actual. *)
+(* AssertEquals (ANY): the compiler calls AssertEquals_<type> when both are of one
+   elementary type; two different types end here, with TcUnit's names of their type
+   classes in Expected and Actual. *)
 METHOD AssertEquals
 VAR_INPUT Expected : STRING(255); Actual : STRING(255); Message : STRING(255); _tcuAt : LINT; END_VAR
-_tcuFail(CONCAT(CONCAT(CONCAT('EXP and ACT differ in type: EXP is ', Expected), ', ACT is '), Actual), Message, _tcuAt);
+IF _tcuActive() THEN
+  _tcuReport(FALSE, CONCAT(CONCAT('(Type class = ', Expected), ')'), CONCAT(CONCAT('(Type class = ', Actual), ')'),
+             Message, 'ANY', _tcuAt);
+END_IF;
+END_METHOD
+
+(* AssertEquals (ANY) of two STRINGs: TcUnit compares their lengths first. *)
+METHOD _tcuAnyEquals_STRING
+VAR_INPUT Expected : STRING(255); Actual : STRING(255); Message : STRING(255); _tcuAt : LINT; END_VAR
+IF NOT _tcuActive() THEN
+  RETURN;
+END_IF;
+IF LEN(Expected) <> LEN(Actual) THEN
+  _tcuReport(FALSE, CONCAT(CONCAT('(Data size (LEN) = ', INT_TO_STRING(LEN(Expected))), ')'),
+             CONCAT(CONCAT('(Data size (LEN) = ', INT_TO_STRING(LEN(Actual))), ')'), Message, 'ANY', _tcuAt);
+ELSE
+  _tcuReport(Expected = Actual, Expected, Actual, Message, 'STRING', _tcuAt);
+END_IF;
+END_METHOD
+
+METHOD _tcuAnyEquals_WSTRING
+VAR_INPUT Expected : WSTRING(255); Actual : WSTRING(255); Message : STRING(255); _tcuAt : LINT; END_VAR
+IF NOT _tcuActive() THEN
+  RETURN;
+END_IF;
+IF _tcuChars(WSTRING_TO_STRING(Expected)) <> _tcuChars(WSTRING_TO_STRING(Actual)) THEN
+  _tcuReport(FALSE, CONCAT(CONCAT('(Data size (WLEN) = ', INT_TO_STRING(_tcuChars(WSTRING_TO_STRING(Expected)))), ')'),
+             CONCAT(CONCAT('(Data size (WLEN) = ', INT_TO_STRING(_tcuChars(WSTRING_TO_STRING(Actual)))), ')'), Message, 'ANY', _tcuAt);
+ELSE
+  AssertEquals_WSTRING(Expected, Actual, Message, _tcuAt);
+END_IF;
 END_METHOD
 )ST";
   for (const auto& e : elementary()) text += assert_equals(e);
-  for (const char* dims : {"", "2d", "3d"})
-    for (const char* t : kArrayTypes) text += assert_array_equals(dims, t);
+  for (const char* t : kArrayTypes) text += assert_array_equals("", t);
+  for (const char* dims : {"2d", "3d"})
+    for (const char* t : {"REAL", "LREAL"}) text += assert_array_equals(dims, t);
   text += "\nEND_FUNCTION_BLOCK\n";
+  for (const auto& e : elementary()) text += write_protected(e);
   return text;
 }
 
@@ -296,12 +365,13 @@ VAR_INPUT
 @D  _tcuAt : LINT;
 END_VAR
 AreEqual@N := @CMP;
-_faLog(AreEqual@N, CONCAT(CONCAT('EXP: ', @E), CONCAT(', ACT: ', @A)), Message, _tcuAt);
+_faLog(AreEqual@N, CONCAT(CONCAT('EXP: ', @E), CONCAT(', ACT: ', @A)), Message, _tcuAt, FALSE, FALSE);
 END_METHOD
 )ST";
   text = replace_all(text, "@D", e.delta ? std::string("  Delta : ") + e.type + ";\n" : "");
   text = replace_all(text, "@CMP", e.delta ? "ABS(Expected - Actual) <= Delta" : "Expected = Actual");
-  const std::string shown = replace_all(e.text, "_tcuHex", "_faHex");
+  // Plain REAL texts (TcUnit's trailing .0 is TcUnit's).
+  const std::string shown = e.delta ? std::string(e.type) + "_TO_STRING(@)" : replace_all(e.text, "_tcuHex", "_faHex");
   text = replace_all(text, "@E", replace_all(shown, "@", "Expected"));
   text = replace_all(text, "@A", replace_all(shown, "@", "Actual"));
   text = replace_all(text, "@N", name);
@@ -310,7 +380,7 @@ END_METHOD
 
 // FB_ASSERT: an instance per test FB (`Assert : FB_ASSERT('FB_Foo')`, the unit's name
 // through FB_init). The test FB steps its own state machine through the State property;
-// every failed assertion (and, with PrintPassed, every passed one) is logged in the global
+// every failed assertion (and, with LogPassed, every passed one) is logged in the global
 // _fa* table, once per state and assertion unless MultipleLog is set; AbortAfterFail skips
 // every assertion after the first failure. `plcfi test --until EXPR` scans the program
 // and reads the log (runtime/fb_assert.cpp).
@@ -332,7 +402,7 @@ FUNCTION_BLOCK FB_ASSERT
 VAR_INPUT
   AbortAfterFail : BOOL;   (* after the first failure, the later assertions are skipped *)
   MultipleLog : BOOL;      (* a message repeated within one state is logged each time *)
-  PrintPassed : BOOL;      (* passed assertions are logged too *)
+  LogPassed : BOOL;        (* passed assertions are logged too *)
 END_VAR
 VAR
   _faName : STRING(80);
@@ -376,23 +446,29 @@ GET
 END_GET
 END_PROPERTY
 
+(* Notice: the test's own line (PrintPassed), logged whatever LogPassed says and not
+   counted as an assertion. *)
 METHOD PRIVATE _faLog
-VAR_INPUT Ok : BOOL; Detail : STRING(255); Message : STRING(255); Loc : LINT; Always : BOOL; END_VAR
+VAR_INPUT Ok : BOOL; Detail : STRING(255); Message : STRING(255); Loc : LINT; Always : BOOL; Notice : BOOL; END_VAR
 VAR i : INT; text : STRING(255); END_VAR
 IF AbortAfterFail AND _faFailed > 0 AND NOT Always THEN
   RETURN;
 END_IF;
-_faChecks := _faChecks + 1;
+IF NOT Notice THEN
+  _faChecks := _faChecks + 1;
+END_IF;
 IF NOT Ok THEN
   _faFailed := _faFailed + 1;
   _faFailures := _faFailures + 1;
-ELSIF NOT PrintPassed THEN
+ELSIF NOT LogPassed AND NOT Notice THEN
   RETURN;
 END_IF;
-IF Message <> '' THEN
+IF Message <> '' AND Detail <> '' THEN
   text := CONCAT(CONCAT(Detail, ', MSG: '), Message);
-ELSE
+ELSIF Detail <> '' THEN
   text := Detail;
+ELSE
+  text := Message;
 END_IF;
 IF NOT MultipleLog THEN
   FOR i := 1 TO _faSeenCount DO
@@ -422,7 +498,17 @@ END_METHOD
    AbortAfterFail stopped the assertions, as the test's own state machine went wrong. *)
 METHOD StateMachineError
 VAR_INPUT _tcuAt : LINT; END_VAR
-_faLog(FALSE, CONCAT('state machine error: no step for state ', DINT_TO_STRING(_faStep)), '', _tcuAt, TRUE);
+_faLog(FALSE, CONCAT('state machine error: no step for state ', DINT_TO_STRING(_faStep)), '', _tcuAt, TRUE, FALSE);
+END_METHOD
+
+(* Assert.PrintPassed('Done'): when no assertion of this unit failed, the message is logged
+   as passed (once per state unless MultipleLog); returns whether none failed. *)
+METHOD PrintPassed : BOOL
+VAR_INPUT Message : STRING(255); _tcuAt : LINT; END_VAR
+PrintPassed := _faFailed = 0;
+IF PrintPassed THEN
+  _faLog(TRUE, '', Message, _tcuAt, TRUE, TRUE);
+END_IF;
 END_METHOD
 
 (* The compiler compares the Size bytes at the two addresses and passes what it found
@@ -436,7 +522,7 @@ VAR_INPUT
   _tcuAt : LINT;
 END_VAR
 AreEqualMEM := Expected = '';
-_faLog(AreEqualMEM, Expected, Message, _tcuAt);
+_faLog(AreEqualMEM, Expected, Message, _tcuAt, FALSE, FALSE);
 END_METHOD
 )ST";
   for (const auto& e : elementary()) text += are_equal(e, e.name);
@@ -453,6 +539,24 @@ END_METHOD
 const char* fb_assert_source() {
   static const std::string text = build_fb_assert();
   return text.c_str();
+}
+
+const char* tcunit_params_source() {
+  // TcUnit's parameters. The runner reads the maximum counts; the xUnit file is written
+  // with plcfi test --xunit FILE, and messages are printed as they come (no ADS queue).
+  return R"ST({attribute 'qualified_only'}
+VAR_GLOBAL CONSTANT
+  MaxNumberOfTestSuites : UINT := 1000;
+  MaxNumberOfTestsForEachTestSuite : UINT := 100;
+  MaxNumberOfAssertsForEachTestSuite : UINT := 1000;
+  LogExtendedResults : BOOL := TRUE;
+  xUnitEnablePublish : BOOL := FALSE;
+  xUnitBufferSize : UDINT := 65535;
+  xUnitFilePath : STRING(255) := '%TC_BOOTPRJPATH%tcunit_xunit_testresults.xml';
+  AdsLogMessageFifoRingBufferSize : UINT := 2000;
+  TimeBetweenTestSuitesExecution : TIME := T#0MS;
+END_VAR
+)ST";
 }
 
 const char* tcunit_source() {

@@ -189,8 +189,10 @@ std::string dt_literal(int64_t ns) { return "DT#" + date_part(ns) + "-" + tod_pa
 
 namespace {
 void time_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, duration_literal(load_as<int64_t>(b))); }
+// LTIME_TO_STRING under --dialect codesys: TwinCAT writes an LTIME as LTIME#... whatever
+// its size (TcUnit's verifier: LTIME#1000d15h23m12s34ms2us44ns).
 void ltime_u_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  put(a, cap, unsigned_duration_literal(load_as<uint64_t>(b)));
+  put(a, cap, duration_text("LTIME#", load_as<uint64_t>(b)));
 }
 void date_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, date_literal(load_as<int64_t>(b))); }
 void tod_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, tod_literal(load_as<int64_t>(b))); }
@@ -318,6 +320,11 @@ void adslog_lreal(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint
   adslog(m, a, b, c, 'f', fmt::format("{:.6f}", load_as<double>(d)));
 }
 void task_index(Machine& m, uint32_t, uint8_t* a, uint8_t*, uint8_t*, uint8_t*) { *a = m.task_index(); }
+// Without a runner (plcfi run of a suite), TcUnit's calls do nothing: no test is current.
+void tcunit_event(Machine& m, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
+  LibraryHook* h = m.hook();
+  store_as<int32_t>(a, h ? h->tcunit(m, load_as<int32_t>(b), load_as<uint32_t>(c)) : 0);
+}
 
 struct Entry {
   NativeFn fn;
@@ -341,6 +348,7 @@ constexpr Entry kNatives[] = {
     {adslog_str, "ADSLOGSTR"}, {adslog_dint, "ADSLOGDINT"}, {adslog_lreal, "ADSLOGLREAL"},
     {task_index, "GETCURTASKINDEX"},
     {ltime_u_to_s, "LTIME_TO_STRING"},
+    {tcunit_event, "__TCUNIT"},
 };
 static_assert(sizeof(kNatives) / sizeof(kNatives[0]) == static_cast<size_t>(Native::Count_));
 

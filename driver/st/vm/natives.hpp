@@ -29,6 +29,9 @@ enum class Native : uint32_t {
   ADSLOG_STR, ADSLOG_DINT, ADSLOG_LREAL,
   TASK_INDEX,              // a: BYTE := the 1-based index of the running task
   LTIME_U_TO_S,            // LTIME_TO_STRING of an unsigned LTIME (--dialect codesys)
+  // TcUnit's library calls its runner: a: DINT := the event's result; b: the event (DINT),
+  // c: the suite instance's address (stdlib/tcunit_abi.hpp). Machine::hook() answers.
+  TCUNIT,
   Count_
 };
 

@@ -941,6 +941,75 @@ int compare(ValueKind k, const uint8_t* a, const uint8_t* b) {
 }
 }  // namespace
 
+namespace {
+
+// An element as TcUnit's assertion messages show it: bit strings in hex, REALs with a
+// decimal point (-23.0).
+std::string tcunit_element(ValueKind kind, uint32_t hex_digits, const uint8_t* p) {
+  if (hex_digits) {
+    uint64_t v = 0;
+    std::memcpy(&v, p, std::min<uint32_t>(hex_digits / 2, 8));
+    return fmt::format("0x{:0{}X}", v, hex_digits);
+  }
+  std::string s = format_value(kind, p);
+  if ((kind == ValueKind::F32 || kind == ValueKind::F64) && s.find_first_of(".eni") == std::string::npos) s += ".0";
+  return s;
+}
+
+// TcUnit's record of an array comparison (tcunit_abi::kSep between the parts).
+std::string tcunit_array_record(Machine& m, const ArrayDiffShape& s, uint32_t addr_e, uint32_t addr_a, double delta) {
+  const auto kind = static_cast<ValueKind>(s.kind);
+  const char sep = '\x1f';
+  auto bounds = [&](const int32_t* lo, const uint32_t* ext) {
+    std::string b, x;
+    for (uint32_t k = 0; k < s.ndims; ++k) {
+      b += fmt::format("{}{}..{}", k ? "," : "", lo[k], static_cast<int64_t>(lo[k]) + ext[k] - 1);
+      x += fmt::format("{}{}", k ? "x" : "", ext[k]);
+    }
+    return fmt::format("[{}] ({})", b, x);
+  };
+  std::string size_e, size_a;
+  if (s.ndims == 1) {
+    size_e = fmt::format("SIZE = {}", s.extent[0]);
+    size_a = fmt::format("SIZE = {}", s.extent_a[0]);
+  } else {
+    size_e = "SIZE = " + bounds(s.lo, s.extent);
+    size_a = "SIZE = " + bounds(s.lo_a, s.extent_a);
+  }
+  const std::string key = size_e + "|" + size_a;
+  bool same_shape = true;
+  for (uint32_t k = 0; k < s.ndims; ++k) same_shape = same_shape && s.extent[k] == s.extent_a[k];
+  if (!same_shape) return std::string("S") + sep + size_e + sep + size_a + sep + key;
+  auto fits = [&](uint32_t addr, uint32_t count, uint32_t size) {
+    return addr != 0 && static_cast<uint64_t>(addr) + static_cast<uint64_t>(count) * size <= m.mem_size();
+  };
+  if (!fits(addr_e, s.count_e, s.elem_size) || !fits(addr_a, s.count_a, s.elem_size_a))
+    return std::string("S") + sep + "an array outside the memory" + sep + "" + sep + key;  // not reached
+  for (uint32_t i = 0; i < s.count_e; ++i) {
+    const uint8_t* x = m.mem() + addr_e + static_cast<size_t>(i) * s.elem_size;
+    const uint8_t* y = m.mem() + addr_a + static_cast<size_t>(i) * s.elem_size_a;
+    bool same;
+    if (kind == ValueKind::F32) same = std::fabs(static_cast<double>(ld<float>(x)) - ld<float>(y)) <= delta;
+    else if (kind == ValueKind::F64) same = std::fabs(ld<double>(x) - ld<double>(y)) <= delta;
+    else same = compare(kind, x, y) == 0;
+    if (same) continue;
+    std::string ie, ia;
+    uint32_t rest = i;
+    for (uint32_t k = s.ndims; k-- > 0;) {
+      const uint32_t ext = s.extent[k] ? s.extent[k] : 1;
+      const std::string sep_k = ie.empty() ? "" : ",";
+      ie = fmt::format("{}{}{}", static_cast<int64_t>(s.lo[k]) + rest % ext, sep_k, ie);
+      ia = fmt::format("{}{}{}", static_cast<int64_t>(s.lo_a[k]) + rest % ext, sep_k, ia);
+      rest /= ext;
+    }
+    return std::string("C") + sep + fmt::format("ARRAY[{}] = {}", ie, tcunit_element(kind, s.hex_digits, x)) + sep +
+           fmt::format("ARRAY[{}] = {}", ia, tcunit_element(kind, s.hex_digits, y)) + sep + key;
+  }
+  return std::string("=") + sep + size_e + sep + size_a + sep + key;
+}
+
+}  // namespace
+
 void array_difference(Machine& m, uint32_t cap, uint8_t* out, uint8_t* blk, uint8_t* shape_bytes, uint8_t*) {
   ArrayDiffShape s;
   std::memcpy(&s, shape_bytes, sizeof s);
@@ -951,7 +1020,9 @@ void array_difference(Machine& m, uint32_t cap, uint8_t* out, uint8_t* blk, uint
   auto fits = [&](uint32_t addr, uint32_t count, uint32_t size) {
     return addr != 0 && static_cast<uint64_t>(addr) + static_cast<uint64_t>(count) * size <= m.mem_size();
   };
-  if (s.count_e != s.count_a) {
+  if (s.style == 1) {
+    msg = tcunit_array_record(m, s, addr_e, addr_a, delta);
+  } else if (s.count_e != s.count_a) {
     msg = fmt::format("EXP: an array of {} elements, ACT: {} elements", s.count_e, s.count_a);
   } else if (!fits(addr_e, s.count_e, s.elem_size) || !fits(addr_a, s.count_a, s.elem_size_a)) {
     msg = "an array outside the memory";  // the compiler passes whole arrays: not reached

@@ -48,6 +48,12 @@ struct ArrayDiffShape {
   uint32_t ndims;             // 1..3: the expected array's dimensions, to name an element
   int32_t lo[3];
   uint32_t extent[3];
+  // 1: TcUnit's AssertArray*Equals (stdlib/tcunit_abi.hpp: a record of the verdict, EXP,
+  // ACT and the key; indices in each array's own bounds); 0: plcfi's words.
+  uint32_t style;
+  uint32_t hex_digits;        // style 1: a bit string, shown as 0x and this many digits
+  int32_t lo_a[3];            // style 1: the actual array's bounds
+  uint32_t extent_a[3];
 };
 void array_difference(Machine& m, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d);
 NativeFn native(uint32_t id);
@@ -57,6 +63,17 @@ const char* native_name(uint32_t id);
 // UTime: CODESYS's unsigned LTIME.
 enum class ValueKind : uint8_t { Bool, I8, I16, I32, I64, U8, U16, U32, U64, F32, F64, Time, Date, Tod, Dt, String, Enum, Ref, UTime };
 enum class AssertKind : uint8_t { Eq, Neq, True, False, Gt, Lt, Ge, Le, Near, Called, CallCount };
+
+class Machine;
+
+// What a host running a built-in library's runner (TcUnit) answers the library's calls
+// with (native TCUNIT); installed with Machine::set_hook.
+class LibraryHook {
+ public:
+  virtual ~LibraryHook() = default;
+  // A TcUnit event (stdlib/tcunit_abi.hpp) of the suite instance at address `suite`.
+  virtual int32_t tcunit(Machine& m, int32_t event, uint32_t suite) = 0;
+};
 
 class Machine {
  public:
@@ -90,6 +107,10 @@ class Machine {
     std::string text;
   };
   std::vector<LogEntry>& log() { return log_; }
+
+  // The runner of a built-in library, if one runs (TcUnit's); not owned.
+  LibraryHook* hook() const { return hook_; }
+  void set_hook(LibraryHook* h) { hook_ = h; }
 
   // Called by a native helper that found a runtime error (MEMCPY outside the memory): the
   // NATIVE instruction that called it then traps with this kind and message, at its own
@@ -170,6 +191,7 @@ class Machine {
   int64_t now_ns_ = 0;
   uint8_t task_index_ = 1;
   std::vector<LogEntry> log_;
+  LibraryHook* hook_ = nullptr;
   TrapKind native_trap_kind_ = TrapKind::None;
   std::string native_trap_msg_;
   uint64_t budget_limit_ = 100'000'000;
