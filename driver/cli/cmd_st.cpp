@@ -18,9 +18,8 @@
 #include "report/junit.hpp"
 #include "common/duration.hpp"
 #include "runtime/schedule.hpp"
-#include "runtime/fb_assert.hpp"
-#include "runtime/tcunit.hpp"
-#include "test_runner.hpp"
+#include "report/tests.hpp"
+#include "testing/suites.hpp"
 
 namespace po = boost::program_options;
 
@@ -260,129 +259,30 @@ int cmd_run(const std::vector<std::string>& args) {
 
 namespace {
 
-// One result line per test, grouped (a test file, a TcUnit suite), and its JUnit case.
-struct TestTally {
-  size_t passed = 0, failed = 0, disabled = 0;
-  std::map<std::string, report::JunitSuite> suites;
-  std::vector<std::string> order;
-  std::string current;
-
-  struct Case {
-    std::string name;
-    enum class Verdict { Pass, Fail, Disabled } verdict = Verdict::Pass;
-    std::vector<std::string> details;  // each shown under a failed test ("file:line:col: message")
-    std::string message;                // JUnit's failure message
-    double seconds = 0;
-    std::vector<std::pair<std::string, std::string>> properties;
-  };
-
-  void add(const std::string& group, const std::string& heading, const std::string& name, bool ok,
-           const std::string& where, const std::string& message, double seconds) {
-    Case c;
-    c.name = name;
-    c.verdict = ok ? Case::Verdict::Pass : Case::Verdict::Fail;
-    if (!ok) c.details.push_back(where.empty() ? message : where + ": " + message);
-    c.message = message;
-    c.seconds = seconds;
-    add(group, heading, c);
-  }
-
-  void add(const std::string& group, const std::string& heading, const Case& c) {
-    if (group != current) {
-      current = group;
-      std::cout << "[" << heading << "]\n";
-    }
-    report::JunitCase j;
-    j.classname = group;
-    j.name = c.name;
-    j.seconds = c.seconds;
-    j.properties = c.properties;
-    switch (c.verdict) {
-      case Case::Verdict::Pass:
-        ++passed;
-        std::cout << "  PASS: " << c.name << "\n";
-        break;
-      case Case::Verdict::Disabled:
-        ++disabled;
-        std::cout << "  DISABLED: " << c.name << "\n";
-        j.outcome = report::JunitCase::Outcome::Skipped;
-        j.message = "disabled";
-        break;
-      case Case::Verdict::Fail:
-        ++failed;
-        std::cout << "  FAIL: " << c.name << "\n";
-        for (const auto& d : c.details) std::cout << "    " << d << "\n";
-        j.outcome = report::JunitCase::Outcome::Fail;
-        j.message = c.message;
-        for (const auto& d : c.details) j.detail += (j.detail.empty() ? "" : "\n") + d;
-        break;
-    }
-    if (!suites.count(group)) order.push_back(group);
-    auto& s = suites[group];
-    s.name = group;
-    s.cases.push_back(std::move(j));
-  }
-
-  std::string totals() const {
-    return fmt::format("{} passed, {} failed{}", passed, failed, disabled ? fmt::format(", {} disabled", disabled) : "");
-  }
-};
-
-// The TcUnit run's results: every suite's tests with their failed assertions, TcUnit's own
-// messages, its summary. Returns false when the run had a problem of its own (a name used
-// twice, more tests or assertions than the parameters allow, TcUnit stopped).
 // TcUnit's extended results (LogExtendedResults), as its log has them after a suite ended.
-void print_tcunit_extended(const rt::TcUnitReport& rep) {
+void print_tcunit_extended(const testing::TcUnitReport& rep) {
   for (size_t i = 0; i < rep.suites.size(); ++i) {
     const auto& s = rep.suites[i];
+    if (s.tests.empty() && s.filtered > 0) continue;  // --filter selected none of its tests
     size_t failed = 0;
     for (const auto& t : s.tests) failed += t.failed;
     std::cout << fmt::format("| Test suite ID={} '{}'\n| ID={} number of tests={}, number of failed tests={}, duration={}\n", i,
-                             s.path, i, s.tests.size(), failed, rt::tcunit_seconds(s.seconds));
+                             s.path, i, s.tests.size(), failed, testing::tcunit_seconds(s.seconds));
     for (const auto& t : s.tests) {
       std::cout << "| Test name=" << t.name << "\n| Test class name=" << s.path << "\n"
                 << fmt::format("| Test status={}, number of asserts={}, duration={}\n",
-                               t.disabled ? "SKIP" : t.failed ? "FAIL" : "PASS", t.asserts, rt::tcunit_seconds(t.seconds));
+                               t.disabled ? "SKIP" : t.failed ? "FAIL" : "PASS", t.asserts, testing::tcunit_seconds(t.seconds));
       if (!t.message.empty()) std::cout << "| Test assert message=" << t.message << "\n";
       if (!t.type.empty()) std::cout << "| Test assert type=" << t.type << "\n";
     }
   }
 }
 
-bool report_tcunit(const rt::TcUnitReport& rep, const st::Application& app, const st::Build& b, TestTally* tally,
-                   bool extended) {
-  size_t tests = 0, failed = 0;
-  for (const auto& s : rep.suites) {
-    const std::string heading = s.path + " (" + s.type->name + ", " + app.where(b.sm.origin(s.type->loc)) + ")";
-    for (const auto& t : s.tests) {
-      ++tests;
-      failed += t.failed;
-      TestTally::Case c;
-      c.name = t.name;
-      c.seconds = t.seconds;
-      c.verdict = t.disabled ? TestTally::Case::Verdict::Disabled
-                  : t.failed ? TestTally::Case::Verdict::Fail
-                             : TestTally::Case::Verdict::Pass;
-      for (const auto& f : t.failures)
-        c.details.push_back(f.where.valid() ? app.where(b.sm.origin(f.where)) + ": " + f.line : f.line);
-      if (!t.problem.empty())
-        c.details.push_back(t.problem_at.valid() ? app.where(b.sm.origin(t.problem_at)) + ": " + t.problem : t.problem);
-      c.message = !t.failures.empty() ? t.failures.front().line : t.problem;
-      c.properties = {{"status", t.disabled ? "SKIP" : t.failed ? "FAIL" : "PASS"},
-                      {"asserts", std::to_string(t.asserts)}};
-      if (!t.type.empty()) c.properties.emplace_back("type", t.type);  // TcUnit's, for its xUnit file
-      if (t.failed) c.properties.emplace_back("message", !t.message.empty() ? t.message : c.message);
-      tally->add(s.path, heading, c);
-    }
-    if (auto it = tally->suites.find(s.path); it != tally->suites.end())
-      it->second.properties = {{"time", rt::tcunit_seconds(s.seconds)}};
-    if (s.tests.empty())
-      std::cout << "[" << heading << "]\n  "
-                << (s.started ? "(no tests)" : "(not started: RUN_IN_SEQUENCE starts a suite when the one before it is done)")
-                << "\n";
-  }
-  // TcUnit's own messages and the program's (TCUNIT_ADSLOGSTR, ADSLOGSTR), in order; the
-  // failed assertions are shown with their tests above.
+// What TcUnit prints besides the tests: its own messages and the program's (TCUNIT_ADSLOGSTR,
+// ADSLOGSTR) in order (the failed assertions are shown with their tests), its errors, the
+// extended results when asked, its summary. Returns false when TcUnit reported an error of
+// its own (a name used twice, more tests or assertions than the parameters allow, stopped).
+bool print_tcunit_tail(const testing::TcUnitReport& rep, bool extended) {
   constexpr size_t kShown = 200;  // a message logged in every cycle of a long run
   size_t shown = 0, more = 0;
   for (const auto& l : rep.log) {
@@ -405,16 +305,52 @@ bool report_tcunit(const rt::TcUnitReport& rep, const st::Application& app, cons
                                s.registered, s.path, rep.max_tests);
     }
   if (extended) print_tcunit_extended(rep);
+  size_t suites = 0, tests = 0, failed = 0;
+  for (const auto& s : rep.suites) {
+    suites += !(s.tests.empty() && s.filtered > 0);  // --filter selected none of its tests
+    for (const auto& t : s.tests) {
+      ++tests;
+      failed += t.failed;
+    }
+  }
   std::cout << "| ==========TESTS FINISHED RUNNING==========\n"
-            << "| Test suites: " << rep.suites.size() << "\n"
+            << "| Test suites: " << suites << "\n"
             << "| Tests: " << tests << "\n"
             << "| Successful tests: " << tests - failed << "\n"
             << "| Failed tests: " << failed << "\n"
-            << "| Duration: " << rt::tcunit_seconds(rep.seconds) << "\n"
+            << "| Duration: " << testing::tcunit_seconds(rep.seconds) << "\n"
             << "| ======================================\n";
   std::cout << fmt::format("TcUnit: {} of virtual time, {} cycles{}\n", common::format_duration(rep.virtual_ns), rep.cycles,
                            rep.timed_out ? "; the time-out ended the run" : rep.aborted ? "; TcUnit stopped" : "");
   return ok;
+}
+
+// --filter, --list, --test-timeout: the same for every kind of test.
+struct TestSelection {
+  testing::Filter filter;
+  bool list = false;
+  int64_t test_timeout_ns = 0;
+};
+
+bool test_selection(const po::variables_map& vm, TestSelection* sel) {
+  if (vm.count("filter")) sel->filter = testing::Filter(vm["filter"].as<std::vector<std::string>>());
+  sel->list = vm.count("list") > 0;
+  if (vm.count("test-timeout")) {
+    std::string err;
+    if (!rt::parse_duration(vm["test-timeout"].as<std::string>(), &sel->test_timeout_ns, &err) || sel->test_timeout_ns <= 0) {
+      std::cerr << "plcfi test: --test-timeout: " << (err.empty() ? "must be positive" : err) << "\n";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool write_junit_of(const po::variables_map& vm, const std::vector<testing::TestSuite>& suites) {
+  if (!vm.count("junit")) return true;
+  std::string err;
+  if (report::write_test_junit(vm["junit"].as<std::string>(), suites, &err)) return true;
+  std::cerr << "plcfi test: " << err << "\n";
+  return false;
 }
 
 // The schedule a TcUnit or --until run scans: the configuration's tasks, or one program.
@@ -438,7 +374,8 @@ bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt
 // `plcfi test --until EXPR`: the program scans until EXPR holds; then FB_ASSERT's log is
 // reported, one group per unit under test. EXPR is compiled as a PROGRAM linked onto the
 // program, so it reaches every instance by path.
-int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileOptions& opt, int64_t timeout_ns) {
+int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileOptions& opt, int64_t timeout_ns,
+                   const TestSelection& sel) {
   const std::string expr = vm["until"].as<std::string>();
   if (!b.tests.empty()) {
     std::cerr << "plcfi test: --until scans the program until a condition holds; it takes no test files "
@@ -477,6 +414,11 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
     std::cerr << "plcfi test: --until: the condition's program is missing\n";
     return 2;
   }
+  if (sel.list) {  // the units are named by FB_init as the program starts: list by running none
+    std::cerr << "plcfi test: --list with --until: FB_ASSERT's units and states are known only as the program runs; "
+                 "run without --list (--filter UNIT or 'UNIT/state N' selects what is reported)\n";
+    return 2;
+  }
   rt::Schedule sched;
   if (!tcunit_schedule(app, vm, &sched, "--until scans the program's tasks")) return 2;
   st::Machine m(app);
@@ -484,26 +426,16 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
   if (vm.count("native") && !(native = load_native(app, "plcfi test"))) return 2;
   m.set_native(native.get());
   m.set_count_hits(coverage_export_wanted(vm));
-  rt::UntilOptions uo;
+  testing::UntilOptions uo;
   uo.timeout_ns = timeout_ns;
+  uo.test_timeout_ns = sel.test_timeout_ns;
+  uo.filter = &sel.filter;
   uo.budget = vm["budget"].as<Count>().value;
-  const rt::UntilReport rep = rt::run_until(app, sched, m, *until, reached->offset, uo);
+  const testing::UntilReport rep = testing::run_until(app, sched, m, *until, reached->offset, uo);
   if (!rep.program_trap.empty()) std::cerr << rep.program_trap << "\n";
-  // One group per unit under test, in the order the units first logged.
-  std::vector<rt::AssertLogEntry> log = rep.log;
-  std::vector<std::string> units;
-  for (const auto& e : log)
-    if (std::find(units.begin(), units.end(), e.unit) == units.end()) units.push_back(e.unit);
-  std::stable_sort(log.begin(), log.end(), [&](const auto& x, const auto& y) {
-    return std::find(units.begin(), units.end(), x.unit) < std::find(units.begin(), units.end(), y.unit);
-  });
-  TestTally tally;
-  for (const auto& e : log) {
-    const std::string unit = e.unit.empty() ? "(FB_ASSERT without a name)" : e.unit;
-    const std::string where = e.where.valid() ? app.where(b.sm.origin(e.where)) : "";
-    tally.add(unit, unit, e.passed ? fmt::format("state {}: {}", e.state, e.message) : fmt::format("state {}", e.state),
-              e.passed, where, e.message, 0.0);
-  }
+  const std::vector<testing::TestSuite> suites = testing::fb_assert_suites(rep, b);
+  report::print_tests(std::cout, suites);
+  const testing::Totals logged = testing::totals(suites);
   if (rep.overflow) std::cout << "  (the log holds 500 entries: later ones were not kept)\n";
   const std::string ending = rep.reached ? fmt::format("--until held after {} of virtual time ({} cycles)",
                                                          common::format_duration(rep.virtual_ns), rep.cycles)
@@ -512,22 +444,15 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
                                                common::format_duration(timeout_ns), rep.cycles)
                                  : fmt::format("a runtime error ended the run after {} cycles", rep.cycles);
   std::cout << fmt::format("FB_ASSERT: {} assertions evaluated, {} failed, {} failures logged; {}\n", rep.checks,
-                           rep.failures, tally.failed, ending);
+                           rep.failures, logged.failed, ending);
   if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
-  // Every evaluation counts, also a failure logged once for several cycles of one state.
-  std::cout << rep.checks - rep.failures << " passed, " << rep.failures << " failed\n";
-  if (vm.count("junit")) {
-    std::vector<report::JunitSuite> v;
-    for (const auto& f : tally.order) v.push_back(tally.suites[f]);
-    std::string err;
-    if (!report::write_junit(vm["junit"].as<std::string>(), v, &err)) {
-      std::cerr << "plcfi test: " << err << "\n";
-      return 2;
-    }
-  }
+  // Every evaluation counts, also a failure logged once for several cycles of one state;
+  // a state that outlasted --test-timeout fails too.
+  std::cout << rep.checks - rep.failures << " passed, " << rep.failures + rep.timeouts << " failed\n";
+  if (!write_junit_of(vm, suites)) return 2;
   if (coverage_export_wanted(vm) && !write_coverage_exports(vm, app, m.hits(), report::coverage_files(b), "plcfi_test", "plcfi test"))
     return 2;
-  return rep.failures > 0 || tally.failed > 0 || !rep.reached ? 1 : 0;
+  return rep.failures > 0 || logged.failed > 0 || !rep.reached ? 1 : 0;
 }
 
 }  // namespace
@@ -546,11 +471,14 @@ int cmd_test(const std::vector<std::string>& args) {
       ("cycle-time", po::value<std::string>()->default_value("10ms"), "TcUnit: cycle time of that program")
       ("tcunit-extended", "TcUnit: print its extended results too (per suite and test: status, number of assertions, duration)")
       ("xunit", po::value<std::string>(), "TcUnit: write the xUnit XML file TcUnit publishes (testsuites, testcase status PASS/FAIL/SKIP, durations)")
+      ("filter", po::value<std::vector<std::string>>(), "run (or list) only the tests this shell pattern matches: their suite's name (test file, TcUnit instance path, FB_ASSERT unit), their own name or SUITE/TEST (repeatable)")
+      ("list", "list the tests (SUITE/TEST) the run would run, and run none")
+      ("test-timeout", po::value<std::string>(), "a time-out per test beside --timeout: a TcUnit test not finished that long after its start fails (the others go on); a test file's test that advanced the clock further fails; an FB_ASSERT unit staying longer in one state fails there")
       ("until", po::value<std::string>(), "scan the program until this ST condition holds (e.g. 'PRG_TEST.fbTest.bDone'), then report FB_ASSERT's failed assertions");
   add_coverage_export_options(desc);
   po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--junit FILE] [--coverage] [--lcov FILE] [--cobertura FILE] [--timeout 10s] [--until EXPR] [--xunit FILE]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--filter GLOB] [--list] [--junit FILE] [--coverage] [--lcov FILE] [--cobertura FILE] [--timeout 10s] [--test-timeout D] [--until EXPR] [--xunit FILE]")) return 0;
   if (!check_coverage_paths(vm, "plcfi test")) return 2;
   int64_t timeout_ns = 0;
   std::string err;
@@ -558,21 +486,29 @@ int cmd_test(const std::vector<std::string>& args) {
     std::cerr << "plcfi test: --timeout: " << (err.empty() ? "must be positive" : err) << "\n";
     return 2;
   }
+  TestSelection sel;
+  if (!test_selection(vm, &sel)) return 2;
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
   opt.test_mode = true;
   opt.warnings = false;
   auto b = load(strings_of(vm, "files"), opt, "test");
   if (!b || !b->ok()) return 2;
-  if (vm.count("until")) return run_until_mode(*b, vm, opt, timeout_ns);
+  if (vm.count("until")) return run_until_mode(*b, vm, opt, timeout_ns, sel);
   const st::Application& app = *b->app;
-  const bool tcunit = rt::has_tcunit_suites(app);
+  const bool tcunit = testing::has_tcunit_suites(app);
   if (b->tests.empty() && !tcunit) {
     std::cerr << "plcfi test: no tests among the inputs: neither a test file (it starts with TEST, SETUP or TEARDOWN) "
                  "nor a TcUnit suite instance (of a function block that EXTENDS FB_TestSuite)"
-              << (rt::has_fb_assert(app) ? "; tests with FB_ASSERT run with --until EXPR (e.g. the test FB's bDone)" : "")
+              << (testing::has_fb_assert(app) ? "; tests with FB_ASSERT run with --until EXPR (e.g. the test FB's bDone)" : "")
               << "\n";
     return 2;
+  }
+  if (sel.list) {  // what would run, without running it
+    std::vector<std::string> names = testing::list_test_files(app, sel.filter);
+    for (auto& n : testing::list_tcunit(*b, sel.filter)) names.push_back(std::move(n));
+    for (const auto& n : names) std::cout << n << "\n";
+    return 0;
   }
   rt::Schedule sched;
   if (tcunit && !tcunit_schedule(app, vm, &sched, "TcUnit suites run in the scan of the program that calls TcUnit.RUN()")) return 2;
@@ -581,52 +517,49 @@ int cmd_test(const std::vector<std::string>& args) {
   if (vm.count("native") && !(native = load_native(app, "plcfi test"))) return 2;
   m.set_native(native.get());
   m.set_count_hits(coverage_export_wanted(vm));
-  TestTally tally;
+  std::vector<testing::TestSuite> suites;
   if (!b->tests.empty()) {
-    st::TestRunOptions ro;
+    testing::TestRunOptions ro;
     ro.budget = vm["budget"].as<Count>().value;
-    for (const auto& r : st::run_tests(app, m, ro)) tally.add(r.file, r.file, r.name, r.passed, r.where, r.message, r.seconds);
+    ro.filter = &sel.filter;
+    ro.test_timeout_ns = sel.test_timeout_ns;
+    suites = testing::test_file_suites(testing::run_tests(app, m, ro));
+    report::print_tests(std::cout, suites);
   }
   bool tcunit_ok = true;
   if (tcunit) {
-    rt::TcUnitOptions to;
+    testing::TcUnitOptions to;
     to.timeout_ns = timeout_ns;
+    to.test_timeout_ns = sel.test_timeout_ns;
+    to.filter = &sel.filter;
     to.budget = vm["budget"].as<Count>().value;
-    const rt::TcUnitReport rep = rt::run_tcunit(app, sched, m, to);
+    const testing::TcUnitReport rep = testing::run_tcunit(app, sched, m, to);
     if (!rep.program_trap.empty()) std::cerr << rep.program_trap << "\n";
     if (!rep.run_called) {
       std::cerr << "plcfi test: TcUnit.RUN() was not called within " << common::format_duration(to.timeout_ns)
                 << ": call it in the program that holds the suites (e.g. PRG_TEST, called by a task)\n";
       return 1;
     }
-    const size_t first = tally.order.size();
-    tcunit_ok = report_tcunit(rep, app, *b, &tally, vm.count("tcunit-extended") > 0);
-    if (vm.count("xunit")) {
-      std::vector<report::JunitSuite> v;
-      for (size_t i = first; i < tally.order.size(); ++i) v.push_back(tally.suites[tally.order[i]]);
-      if (!report::write_tcunit_xunit(vm["xunit"].as<std::string>(), v, rep.seconds, &err)) {
-        std::cerr << "plcfi test: " << err << "\n";
-        return 2;
-      }
+    std::vector<testing::TestSuite> tc = testing::tcunit_suites(rep, *b);
+    report::print_tests(std::cout, tc);
+    tcunit_ok = print_tcunit_tail(rep, vm.count("tcunit-extended") > 0);
+    if (vm.count("xunit") && !report::write_tcunit_xunit(vm["xunit"].as<std::string>(), tc, rep.seconds, &err)) {
+      std::cerr << "plcfi test: " << err << "\n";
+      return 2;
     }
+    for (auto& s : tc) suites.push_back(std::move(s));
   } else if (vm.count("xunit")) {
     std::cerr << "plcfi test: --xunit writes TcUnit's xUnit file: there are no TcUnit suites among the inputs (use --junit)\n";
     return 2;
   }
   if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
-  std::cout << tally.totals() << "\n";
-  if (vm.count("junit")) {
-    std::vector<report::JunitSuite> v;
-    for (const auto& f : tally.order) v.push_back(tally.suites[f]);
-    if (!report::write_junit(vm["junit"].as<std::string>(), v, &err)) {
-      std::cerr << "plcfi test: " << err << "\n";
-      return 2;
-    }
-  }
+  const testing::Totals totals = testing::totals(suites);
+  std::cout << report::totals_line(totals) << "\n";
+  if (!write_junit_of(vm, suites)) return 2;
   if (coverage_export_wanted(vm) &&
       !write_coverage_exports(vm, app, m.hits(), report::coverage_files(*b), "plcfi_test", "plcfi test"))
     return 2;
-  return tally.failed || !tcunit_ok ? 1 : 0;
+  return totals.failed || !tcunit_ok ? 1 : 0;
 }
 
 }  // namespace plcfi::cli

@@ -101,10 +101,8 @@ std::string junit_xml(const std::vector<JunitSuite>& suites) {
   return out;
 }
 
-namespace {
-
 // Writes atomically (temporary file + rename).
-bool write_file(const std::string& path, const std::string& text, std::string* err) {
+bool write_file_atomically(const std::string& path, const std::string& text, std::string* err) {
   std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
@@ -125,64 +123,8 @@ bool write_file(const std::string& path, const std::string& text, std::string* e
   return true;
 }
 
-std::string property(const std::vector<std::pair<std::string, std::string>>& props, const char* key) {
-  for (const auto& [k, v] : props)
-    if (k == key) return v;
-  return "";
-}
-
-// TcUnit's texts of seconds: LREAL_TO_STRING with a decimal point.
-std::string seconds_text(double s) {
-  std::string t = fmt::format("{}", s);
-  if (t.find_first_of(".eni") == std::string::npos) t += ".0";
-  return t;
-}
-
-}  // namespace
-
 bool write_junit(const std::string& path, const std::vector<JunitSuite>& suites, std::string* err) {
-  return write_file(path, junit_xml(suites), err);
-}
-
-std::string tcunit_xunit_xml(const std::vector<JunitSuite>& suites, double seconds) {
-  size_t failed = 0, tests = 0;
-  for (const auto& s : suites)
-    for (const auto& c : s.cases) {
-      ++tests;
-      failed += c.outcome == JunitCase::Outcome::Fail;
-    }
-  // TcUnit's "tests" of the whole run counts its successful tests.
-  std::string out = fmt::format("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites disabled=\"\" failures=\"{}\" "
-                                "tests=\"{}\" time=\"{}\">\n",
-                                failed, tests - failed, seconds_text(seconds));
-  for (size_t i = 0; i < suites.size(); ++i) {
-    const auto& s = suites[i];
-    size_t f = 0;
-    for (const auto& c : s.cases) f += c.outcome == JunitCase::Outcome::Fail;
-    std::string time = property(s.properties, "time");
-    out += fmt::format("  <testsuite id=\"{}\" name=\"{}\" tests=\"{}\" failures=\"{}\" time=\"{}\">\n", i,
-                       xml_escape(s.name), s.cases.size(), f, time.empty() ? "0.0" : xml_escape(time));
-    for (const auto& c : s.cases) {
-      const char* status = c.outcome == JunitCase::Outcome::Fail      ? "FAIL"
-                           : c.outcome == JunitCase::Outcome::Skipped ? "SKIP"
-                                                                      : "PASS";
-      out += fmt::format("    <testcase name=\"{}\" classname=\"{}\" time=\"{}\" status=\"{}\"", xml_escape(c.name),
-                         xml_escape(c.classname), seconds_text(c.seconds), status);
-      if (c.outcome == JunitCase::Outcome::Fail) {
-        out += fmt::format(">\n      <failure message=\"{}\" type=\"{}\"/>\n    </testcase>\n",
-                           xml_escape(property(c.properties, "message")),
-                           xml_escape(property(c.properties, "type")));
-      } else {
-        out += "></testcase>\n";
-      }
-    }
-    out += "  </testsuite>\n";
-  }
-  return out + "</testsuites>\n";
-}
-
-bool write_tcunit_xunit(const std::string& path, const std::vector<JunitSuite>& suites, double seconds, std::string* err) {
-  return write_file(path, tcunit_xunit_xml(suites, seconds), err);
+  return write_file_atomically(path, junit_xml(suites), err);
 }
 
 }  // namespace plcfi::report

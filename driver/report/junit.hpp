@@ -27,12 +27,7 @@ std::string junit_xml(const std::vector<JunitSuite>& suites);
 bool write_junit(const std::string& path, const std::vector<JunitSuite>& suites, std::string* err);
 std::string xml_escape(const std::string& s);
 
-// The xUnit file TcUnit publishes: <testsuites> with failures, tests and time; a
-// <testsuite> per suite (id, name, tests, failures, time); a <testcase> per test (name,
-// classname, time, status PASS/FAIL/SKIP) with a <failure message type> when it failed (the
-// case's properties "message" and "type": TcUnit's failure message, the user's of its first
-// failed assertion, and assertion type). `seconds`: the whole run.
-std::string tcunit_xunit_xml(const std::vector<JunitSuite>& suites, double seconds);
-bool write_tcunit_xunit(const std::string& path, const std::vector<JunitSuite>& suites, double seconds, std::string* err);
+// Writes text to path atomically (a temporary file, then a rename).
+bool write_file_atomically(const std::string& path, const std::string& text, std::string* err);
 
 }  // namespace plcfi::report

@@ -12,7 +12,7 @@
 
 #include "engine.hpp"
 #include "native/native.hpp"
-#include "test_runner.hpp"
+#include "testing/test_files.hpp"
 
 namespace plcfi::st {
 namespace {
@@ -322,10 +322,10 @@ TEST_P(NativeMutations, GiveTheSameResultsInBothTiers) {
     ASSERT_TRUE(native) << err;
     Machine a(*b->app), n(*b->app);
     n.set_native(native.get());
-    TestRunOptions ro;
+    testing::TestRunOptions ro;
     ro.budget = 200'000;
-    auto ra = run_tests(*b->app, a, ro);
-    auto rn = run_tests(*b->app, n, ro);
+    auto ra = testing::run_tests(*b->app, a, ro);
+    auto rn = testing::run_tests(*b->app, n, ro);
     ASSERT_EQ(ra.size(), rn.size());
     for (size_t i = 0; i < ra.size(); ++i) {
       EXPECT_EQ(ra[i].name, rn[i].name);

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "engine.hpp"
-#include "test_runner.hpp"
+#include "testing/test_files.hpp"
 
 namespace plcfi::st {
 namespace {
@@ -77,9 +77,9 @@ TEST(PipelineFuzz, MutatedSourcesNeverCrash) {
     }
     ++compiled;
     Machine m(*b->app);
-    TestRunOptions ro;
+    testing::TestRunOptions ro;
     ro.budget = 20000;
-    run_tests(*b->app, m, ro);  // traps are fine; crashes and hangs are not
+    testing::run_tests(*b->app, m, ro);  // traps are fine; crashes and hangs are not
   }
   // Both outcomes occur: mutations that break nothing (in comments, swapped independent
   // lines) and ones that break the program; all-rejected would mean a broken corpus.

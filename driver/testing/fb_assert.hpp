@@ -1,24 +1,29 @@
 // Runs unit tests written in the assertion-FB style (FB_ASSERT, st/stdlib/tcunit.cpp):
-// the schedule's programs scan in virtual time until a condition holds (typically the test
-// FBs' `bDone OR bError`) or the time-out, then the assertions' log is read.
+// the schedule's programs scan in virtual time (testing/scan.hpp) until a condition holds
+// (typically the test FBs' `bDone OR bError`) or the time-out, then the assertions' log is
+// read. Each unit's state machine (Assert.State) is followed: a state is a step of the test,
+// its duration is reported with its entries, and --test-timeout bounds it.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "schedule.hpp"
+#include "filter.hpp"
+#include "runtime/schedule.hpp"
 #include "vm/vm.hpp"
 
-namespace plcfi::rt {
+namespace plcfi::testing {
 
-// One entry of FB_ASSERT's log: a failed assertion, or a passed one (PrintPassed).
+// One entry of FB_ASSERT's log: a failed assertion, or a passed one (LogPassed,
+// PrintPassed), or a state that outlasted --test-timeout.
 struct AssertLogEntry {
   std::string unit;      // the name its FB_ASSERT got through FB_init ('FB_Foo')
   int64_t state = 0;     // Assert.State when it was evaluated
   bool passed = false;
   std::string message;   // "EXP: 5, ACT: 4, MSG: ..."
   st::SourceLoc where;   // the assertion (not valid for none)
+  double seconds = 0;    // how long the unit was in that state (its last stay), virtual time
 };
 
 struct UntilReport {
@@ -30,11 +35,14 @@ struct UntilReport {
   bool overflow = false;     // more entries were due than the log holds (500)
   int64_t checks = 0;        // assertions evaluated
   int64_t failures = 0;      // of them failed (repeats included)
+  int64_t timeouts = 0;      // states that outlasted --test-timeout
 };
 
 struct UntilOptions {
   int64_t timeout_ns = 10'000'000'000;
+  int64_t test_timeout_ns = 0;   // a unit staying longer in one state fails there (0: no bound)
   uint64_t budget = 10'000'000;  // loop iterations per call (watchdog)
+  const Filter* filter = nullptr;  // entries of units (suites) / states (tests) not selected are dropped
 };
 
 // True when the application holds the FB_ASSERT library.
@@ -42,7 +50,7 @@ bool has_fb_assert(const st::Application& app);
 
 // Runs machine m (cold-restarted first) until the BOOL at `reached` (an output of the
 // observer program `until`, called after every cycle's programs) is TRUE.
-UntilReport run_until(const st::Application& app, const Schedule& schedule, st::Machine& m,
+UntilReport run_until(const st::Application& app, const rt::Schedule& schedule, st::Machine& m,
                       const st::ProgramInstance& until, uint32_t reached, const UntilOptions& opt);
 
-}  // namespace plcfi::rt
+}  // namespace plcfi::testing

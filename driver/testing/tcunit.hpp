@@ -26,10 +26,11 @@
 #include <string>
 #include <vector>
 
-#include "schedule.hpp"
+#include "filter.hpp"
+#include "runtime/schedule.hpp"
 #include "vm/vm.hpp"
 
-namespace plcfi::rt {
+namespace plcfi::testing {
 
 // A failed assertion as TcUnit reports it.
 struct TcUnitFailure {
@@ -57,6 +58,7 @@ struct TcUnitSuite {
   std::vector<TcUnitTest> tests;
   uint32_t registered = 0;  // tests its TESTs named, beyond the ones kept when over the maximum
   bool started = false;    // its body was called (RUN_IN_SEQUENCE starts one after the other)
+  uint32_t filtered = 0;   // tests --filter did not select (run, not reported)
   double seconds = 0;      // from its first call to its last test's end
 };
 
@@ -82,17 +84,21 @@ struct TcUnitReport {
 
 struct TcUnitOptions {
   int64_t timeout_ns = 10'000'000'000;  // plcfi's bound on the run (TcUnit has none)
+  int64_t test_timeout_ns = 0;          // a test not finished this long after its start fails (0: none)
   uint64_t budget = 10'000'000;         // loop iterations per call (watchdog)
+  const Filter* filter = nullptr;       // tests not selected run (TcUnit calls them) but are not reported
 };
 
 // True when the application holds at least one TcUnit suite instance.
 bool has_tcunit_suites(const st::Application& app);
+// Every suite instance: its path and type, in the order TcUnit runs them.
+std::vector<std::pair<std::string, const st::PouInfo*>> tcunit_suite_instances(const st::Application& app);
 
 // Runs the suites on machine m (cold-restarted first). Traps in a suite fail its current
 // test and stop that suite; a trap in a scanned program stops the run.
-TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st::Machine& m, const TcUnitOptions& opt);
+TcUnitReport run_tcunit(const st::Application& app, const rt::Schedule& schedule, st::Machine& m, const TcUnitOptions& opt);
 
 // TcUnit's text of a number of seconds (LREAL_TO_STRING with a decimal point: 0.0, 0.01).
 std::string tcunit_seconds(double s);
 
-}  // namespace plcfi::rt
+}  // namespace plcfi::testing

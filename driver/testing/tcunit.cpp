@@ -1,4 +1,4 @@
-// TcUnit runner: find the suite instances, scan, call the suites, read their results.
+// TcUnit runner: find the suite instances, scan, call the suites, apply TcUnit's rules.
 #include "tcunit.hpp"
 
 #include <algorithm>
@@ -12,9 +12,11 @@
 #include "engine.hpp"
 #include "stdlib/tcunit_abi.hpp"
 #include "common/duration.hpp"
+#include "instances.hpp"
+#include "scan.hpp"
 #include "vm/memory.hpp"
 
-namespace plcfi::rt {
+namespace plcfi::testing {
 
 namespace {
 
@@ -24,51 +26,10 @@ const st::PouInfo* suite_base(const st::Application& app) {
   return nullptr;
 }
 
-bool derives(const st::PouInfo* p, const st::PouInfo* base) {
-  for (int depth = 0; p && depth < 64; p = p->base, ++depth)
-    if (p == base) return true;
-  return false;
-}
-
-struct Found {
-  std::string path;
-  const st::PouInfo* type;
-  uint32_t addr;
-};
-
-// Every instance of a type derived from FB_TestSuite inside a value of type t at addr:
-// members of FB instances and STRUCTs, elements of arrays.
-void collect(const st::Type* t, uint32_t addr, const std::string& path, const st::PouInfo* base, int depth,
-             std::vector<Found>* out) {
-  if (!t || depth > 32 || out->size() > 10'000) return;
-  if (t->kind == st::TypeKind::Pou && t->pou) {
-    if (t->pou != base && derives(t->pou, base)) {
-      out->push_back(Found{path, t->pou, addr});
-      return;  // a suite's own members are its business
-    }
-  }
-  if ((t->kind == st::TypeKind::Pou && t->pou) || (t->kind == st::TypeKind::Struct && !t->is_union)) {
-    for (const auto& f : t->fields) collect(f.type, addr + f.offset, path + "." + f.name, base, depth + 1, out);
-    return;
-  }
-  if (t->kind == st::TypeKind::Array && t->elem && t->dims.size() == 1 &&
-      (t->elem->kind == st::TypeKind::Pou || t->elem->kind == st::TypeKind::Struct)) {
-    const auto& d = t->dims[0];
-    for (int64_t i = d.lo; i <= d.hi && out->size() <= 10'000; ++i)
-      collect(t->elem, addr + static_cast<uint32_t>(i - d.lo) * t->elem->size, fmt::format("{}[{}]", path, i), base,
-              depth + 1, out);
-  }
-}
-
 std::vector<Found> find_suites(const st::Application& app) {
-  std::vector<Found> out;
   const st::PouInfo* base = suite_base(app);
-  if (!base) return out;
-  for (const auto& inst : app.programs)
-    if (inst.pou) collect(inst.pou->type, inst.addr, inst.name, base, 0, &out);
-  for (const auto& g : app.globals)
-    if (g.sym && g.sym->where == st::Where::Abs) collect(g.sym->type, g.sym->offset, g.scope + "." + g.sym->name, base, 0, &out);
-  return out;
+  if (!base) return {};
+  return find_instances(app, [&](const st::PouInfo* p) { return p != base && derives(p, base); });
 }
 
 const st::Symbol* global(const st::Application& app, const char* name, const char* scope = nullptr) {
@@ -79,8 +40,7 @@ const st::Symbol* global(const st::Application& app, const char* name, const cha
 }
 
 // A GVL_Param_TcUnit value (an unsigned integer), or `fallback` when it is not declared.
-uint32_t param(const st::Application& app, const st::Machine& m, const char* name, uint32_t fallback) {
-  const st::Symbol* s = global(app, name, "GVL_Param_TcUnit");
+uint32_t param(const st::Symbol* s, const st::Machine& m, uint32_t fallback) {
   if (!s || !s->type) return fallback;
   const uint8_t* p = m.mem() + s->offset;
   switch (s->type->size) {
@@ -143,6 +103,7 @@ struct LiveTest {
   bool duplicate_told = false;
   uint32_t order = 0;             // TEST_ORDERED's position (1-based); 0: not ordered
   int64_t started_ns = -1;
+  bool filtered = false;          // not selected by --filter: run, not reported
 };
 
 struct LiveSuite {
@@ -162,17 +123,34 @@ struct LiveSuite {
   int current_at_trap = -1;
 };
 
+bool all_finished(const LiveSuite& s) {
+  if (s.tests.empty()) return s.started;  // TcUnit: a suite without tests, after its first call
+  for (const auto& t : s.tests)
+    if (!t.result.finished && !t.result.disabled && !t.filtered) return false;
+  return true;
+}
+
 // The runner's side of TcUnit's library: TcUnit's global state (the test being called,
 // whether its assertions are ignored) and every suite's tests and assertions.
-class Runner : public st::LibraryHook {
+class Runner : public st::LibraryHook, public ScanTest {
  public:
-  Runner(const st::PouInfo* base, TcUnitReport* rep) : box_(mailbox_of(base)), rep_(rep) {}
+  Runner(const st::PouInfo* base, TcUnitReport* rep, const TcUnitOptions& opt)
+      : box_(mailbox_of(base)), rep_(rep), opt_(opt) {}
+
+  // After each scan: when RUN() was called in it, every suite not done (RUN_IN_SEQUENCE:
+  // the first one not done) is called once. False when all are done or TcUnit stopped.
+  bool after_scan(st::Machine& m, uint64_t n, int64_t now) override;
 
   bool valid() const { return box_.valid(); }
   std::vector<LiveSuite>& suites() { return suites_; }
   void set_cycle(uint64_t n, int64_t now_ns) {
     cycle_ = n;
     now_ns_ = now_ns;
+  }
+  void set_tick(int64_t tick) { tick_ = tick; }
+  void set_params(const st::Symbol* max_tests, const st::Symbol* max_asserts) {
+    max_tests_sym_ = max_tests;
+    max_asserts_sym_ = max_asserts;
   }
   void set_limits(uint32_t max_tests, uint32_t max_asserts) {
     max_tests_ = max_tests;
@@ -256,7 +234,7 @@ class Runner : public st::LibraryHook {
     if (disabled) name = name.substr(9);
     LiveTest* t = by_name(s, name);
     if (t) {
-      if (t->touched == cycle_) {  // a second test of this name in this cycle
+      if (t->touched == cycle_ && !t->filtered) {  // a second test of this name in this cycle
         ignore_ = true;
         if (!t->duplicate_told) {
           t->duplicate_told = true;
@@ -270,6 +248,7 @@ class Runner : public st::LibraryHook {
         LiveTest n;
         n.result.name = name;
         n.result.disabled = disabled;
+        n.filtered = opt_.filter && !opt_.filter->selects(s.at.path, name);
         n.touched = cycle_;
         if (ordered) n.order = ++s.ordered;
         s.tests.push_back(std::move(n));
@@ -279,7 +258,8 @@ class Runner : public st::LibraryHook {
     current_test_ = t ? static_cast<int>(t - s.tests.data()) : -1;
     const LiveTest* named = by_name(s, given);  // TcUnit looks the unstripped name up
     current_finished_ = named && named->result.finished;
-    if (disabled) {
+    if (disabled || (t && t->filtered)) {  // not run: its assertions are ignored
+      if (ordered && t && t->filtered && t->order == s.turn) ++s.turn;  // the next one's turn
       ignore_ = true;
       return false;
     }
@@ -379,6 +359,35 @@ class Runner : public st::LibraryHook {
 
   Mailbox box_;
   TcUnitReport* rep_;
+  const TcUnitOptions& opt_;
+  const st::Symbol *run_ = nullptr, *mode_ = nullptr, *pause_ = nullptr;
+  int64_t first_run_ns_ = -1, next_start_ns_ = 0, tick_ = 0;
+  const st::Symbol *max_tests_sym_ = nullptr, *max_asserts_sym_ = nullptr;
+
+  // --test-timeout: a test not finished that long after its first TEST call fails and is
+  // finished (its later assertions are ignored), so the suite goes on.
+  void time_out_tests(LiveSuite& s, int64_t now) {
+    if (opt_.test_timeout_ns <= 0) return;
+    for (auto& t : s.tests) {
+      if (t.result.finished || t.result.disabled || t.filtered || t.started_ns < 0) continue;
+      if (now - t.started_ns + tick_ <= opt_.test_timeout_ns) continue;
+      t.result.finished = true;
+      t.result.failed = true;
+      t.result.seconds = static_cast<double>(now + tick_ - t.started_ns) / 1e9;
+      t.result.problem = fmt::format("not finished within the per-test time-out ({}): TEST_FINISHED() was not called",
+                                     common::format_duration(opt_.test_timeout_ns));
+    }
+  }
+
+ public:
+  void set_globals(const st::Symbol* run, const st::Symbol* mode, const st::Symbol* pause) {
+    run_ = run;
+    mode_ = mode;
+    pause_ = pause;
+  }
+  int64_t first_run_ns() const { return first_run_ns_; }
+
+ private:
   std::vector<LiveSuite> suites_;
   LiveSuite* current_suite_ = nullptr;
   std::string current_name_;
@@ -389,11 +398,49 @@ class Runner : public st::LibraryHook {
   uint32_t max_tests_ = 100, max_asserts_ = 1000;
 };
 
-bool all_finished(const LiveSuite& s) {
-  if (s.tests.empty()) return s.started;  // TcUnit: a suite without tests, after its first call
-  for (const auto& t : s.tests)
-    if (!t.result.finished && !t.result.disabled) return false;
-  return true;
+bool Runner::after_scan(st::Machine& m, uint64_t n, int64_t now) {
+  if (n == 0) {  // GVL_Param_TcUnit's constants, initialised by the restart
+    rep_->max_tests = param(max_tests_sym_, m, 100);
+    rep_->max_asserts = param(max_asserts_sym_, m, 1000);
+    set_limits(rep_->max_tests, rep_->max_asserts);
+  }
+  for (auto& e : m.log()) rep_->log.push_back(TcUnitLogLine{e.level, e.text});  // the program's ADSLOGSTR
+  m.log().clear();
+  uint8_t* mem = m.mem();
+  if (st::load_as<int32_t>(mem + run_->offset) == 0) return true;  // RUN() not called in this scan
+  rep_->run_called = true;
+  if (first_run_ns_ < 0) first_run_ns_ = now;
+  st::store_as<int32_t>(mem + run_->offset, 0);
+  const bool in_sequence = st::load_as<int16_t>(mem + mode_->offset) == 2;
+  set_cycle(n + 1, now);
+  for (auto& s : suites_) {
+    if (s.done) continue;
+    if (in_sequence && now < next_start_ns_) break;  // TimeBetweenTestSuitesExecution
+    if (!s.started) s.started_ns = now;
+    s.started = true;
+    enter(&s);
+    if (!m.call(s.at.type->entry, s.at.addr)) {
+      s.stopped = true;
+      s.done = true;
+      s.trap = st::describe_trap_kind(m.trap());
+      s.trap_loc = m.trap().loc;
+      s.current_at_trap = current_test_;
+    } else {
+      time_out_tests(s, now);
+      s.done = all_finished(s);
+    }
+    for (auto& e : m.log()) rep_->log.push_back(TcUnitLogLine{e.level, e.text});  // TCUNIT_ADSLOGSTR, in order
+    m.log().clear();
+    if (s.done) {
+      s.seconds = static_cast<double>(now - s.started_ns) / 1e9;
+      if (in_sequence && pause_) next_start_ns_ = now + tick_ + st::load_as<int64_t>(m.mem() + pause_->offset);
+    }
+    if (aborted_) return false;
+    if (in_sequence && !s.done) break;  // the next suite starts when this one is done
+  }
+  for (const auto& s : suites_)
+    if (!s.done) return true;
+  return false;
 }
 
 }  // namespace
@@ -406,15 +453,22 @@ std::string tcunit_seconds(double s) {
 
 bool has_tcunit_suites(const st::Application& app) { return !find_suites(app).empty(); }
 
-TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st::Machine& m, const TcUnitOptions& opt) {
+std::vector<std::pair<std::string, const st::PouInfo*>> tcunit_suite_instances(const st::Application& app) {
+  std::vector<std::pair<std::string, const st::PouInfo*>> out;
+  for (const auto& f : find_suites(app)) out.emplace_back(f.path, f.type);
+  return out;
+}
+
+TcUnitReport run_tcunit(const st::Application& app, const rt::Schedule& schedule, st::Machine& m, const TcUnitOptions& opt) {
   TcUnitReport rep;
   const st::PouInfo* base = suite_base(app);
   const st::Symbol* run = global(app, "_TcUnitRun");
   const st::Symbol* mode = global(app, "_TcUnitMode");
   const st::Symbol* pause = global(app, "_TcUnitPause");
   if (!base || !run || !mode) return rep;
-  Runner runner(base, &rep);
+  Runner runner(base, &rep, opt);
   if (!runner.valid()) return rep;
+  runner.set_globals(run, mode, pause);
   for (auto& f : find_suites(app)) {
     LiveSuite s;
     s.at = f;
@@ -422,83 +476,21 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
   }
   auto& live = runner.suites();
 
-  m.set_budget(opt.budget);
   m.set_hook(&runner);
   struct Unhook {
     st::Machine& m;
     ~Unhook() { m.set_hook(nullptr); }
   } unhook{m};
-  if (!m.cold_restart()) {
-    rep.program_trap = st::describe_trap(app, m.trap()) + " (in FB_init/FB_exit at the restart)";
-    return rep;
-  }
-  rep.max_tests = param(app, m, "MaxNumberOfTestsForEachTestSuite", 100);
-  rep.max_asserts = param(app, m, "MaxNumberOfAssertsForEachTestSuite", 1000);
-  runner.set_limits(rep.max_tests, rep.max_asserts);
-  const int64_t tick = schedule.tick_ns();
-  uint64_t n = 0;
-  int64_t first_run_ns = -1, next_start_ns = 0;  // RUN_IN_SEQUENCE: the next suite's earliest start
-  auto pending = [&] {
-    for (const auto& s : live)
-      if (!s.done) return true;
-    return false;
-  };
-  while (pending() && !runner.aborted()) {
-    const int64_t now = static_cast<int64_t>(n) * tick;
-    if (now >= opt.timeout_ns) {
-      rep.timed_out = true;
-      break;
-    }
-    m.set_now(now);
-    m.clear_taken();
-    schedule.run_due(app, m, n, &rep.program_trap);
-    for (auto& e : m.log()) rep.log.push_back(TcUnitLogLine{e.level, e.text});  // the program's ADSLOGSTR
-    m.log().clear();
-    ++n;
-    if (!rep.program_trap.empty()) {
-      m.merge_coverage();
-      break;
-    }
-    uint8_t* mem = m.mem();
-    if (st::load_as<int32_t>(mem + run->offset) == 0) {  // RUN() not called in this scan
-      m.merge_coverage();
-      continue;
-    }
-    rep.run_called = true;
-    if (first_run_ns < 0) first_run_ns = now;
-    st::store_as<int32_t>(mem + run->offset, 0);
-    const bool in_sequence = st::load_as<int16_t>(mem + mode->offset) == 2;
-    runner.set_cycle(n, now);
-    for (auto& s : live) {
-      if (s.done) continue;
-      if (in_sequence && now < next_start_ns) break;  // TimeBetweenTestSuitesExecution
-      if (!s.started) s.started_ns = now;
-      s.started = true;
-      runner.enter(&s);
-      if (!m.call(s.at.type->entry, s.at.addr)) {
-        s.stopped = true;
-        s.done = true;
-        s.trap = st::describe_trap_kind(m.trap());
-        s.trap_loc = m.trap().loc;
-        s.current_at_trap = runner.current_test_index();
-      } else {
-        s.done = all_finished(s);
-      }
-      for (auto& e : m.log()) rep.log.push_back(TcUnitLogLine{e.level, e.text});  // TCUNIT_ADSLOGSTR, in order
-      m.log().clear();
-      if (s.done) {
-        s.seconds = static_cast<double>(now - s.started_ns) / 1e9;
-        if (in_sequence && pause) next_start_ns = now + tick + st::load_as<int64_t>(m.mem() + pause->offset);
-      }
-      if (runner.aborted()) break;
-      if (in_sequence && !s.done) break;  // the next suite starts when this one is done
-    }
-    m.merge_coverage();  // branch coverage of the program and the suites (--coverage)
-  }
-  rep.cycles = n;
-  rep.virtual_ns = static_cast<int64_t>(n) * tick;
+  runner.set_params(global(app, "MaxNumberOfTestsForEachTestSuite", "GVL_Param_TcUnit"),
+                    global(app, "MaxNumberOfAssertsForEachTestSuite", "GVL_Param_TcUnit"));
+  runner.set_tick(schedule.tick_ns());
+  const ScanRun scans = run_scans(app, schedule, m, runner, opt.timeout_ns, opt.budget);
+  rep.program_trap = scans.program_trap;
+  rep.cycles = scans.cycles;
+  rep.virtual_ns = scans.virtual_ns;
+  rep.timed_out = scans.timed_out;
   rep.aborted = runner.aborted();
-  rep.seconds = first_run_ns < 0 ? 0.0 : static_cast<double>(rep.virtual_ns - first_run_ns) / 1e9;
+  rep.seconds = runner.first_run_ns() < 0 ? 0.0 : static_cast<double>(rep.virtual_ns - runner.first_run_ns()) / 1e9;
 
   for (auto& s : live) {
     TcUnitSuite out;
@@ -508,6 +500,10 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
     out.registered = s.registered;
     out.seconds = s.seconds;
     for (size_t i = 0; i < s.tests.size(); ++i) {
+      if (s.tests[i].filtered) {
+        ++out.filtered;
+        continue;
+      }
       TcUnitTest t = std::move(s.tests[i].result);
       if (t.disabled) {
         t.failed = false;
@@ -538,4 +534,4 @@ TcUnitReport run_tcunit(const st::Application& app, const Schedule& schedule, st
   return rep;
 }
 
-}  // namespace plcfi::rt
+}  // namespace plcfi::testing
