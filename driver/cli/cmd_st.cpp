@@ -345,6 +345,12 @@ bool test_selection(const po::variables_map& vm, TestSelection* sel) {
   return true;
 }
 
+// A --filter that selects nothing is a mistake (a misspelt name), not a green run.
+int no_test_selected() {
+  std::cerr << "plcfi test: --filter selected no test: --list shows the tests and their names (SUITE/TEST)\n";
+  return 2;
+}
+
 bool write_junit_of(const po::variables_map& vm, const std::vector<testing::TestSuite>& suites) {
   if (!vm.count("junit")) return true;
   std::string err;
@@ -508,6 +514,7 @@ int cmd_test(const std::vector<std::string>& args) {
     std::vector<std::string> names = testing::list_test_files(app, sel.filter);
     for (auto& n : testing::list_tcunit(*b, sel.filter)) names.push_back(std::move(n));
     for (const auto& n : names) std::cout << n << "\n";
+    if (names.empty() && !sel.filter.empty()) return no_test_selected();
     return 0;
   }
   rt::Schedule sched;
@@ -555,6 +562,7 @@ int cmd_test(const std::vector<std::string>& args) {
   if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
   const testing::Totals totals = testing::totals(suites);
   std::cout << report::totals_line(totals) << "\n";
+  if (totals.all() == 0 && !sel.filter.empty()) return no_test_selected();
   if (!write_junit_of(vm, suites)) return 2;
   if (coverage_export_wanted(vm) &&
       !write_coverage_exports(vm, app, m.hits(), report::coverage_files(*b), "plcfi_test", "plcfi test"))

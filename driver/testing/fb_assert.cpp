@@ -64,7 +64,6 @@ class UntilScan : public ScanTest {
 
   std::vector<Unit> units;
   std::vector<AssertLogEntry> timeouts;
-  int64_t tick = 0;
 
   bool after_scan(st::Machine& m, uint64_t n, int64_t now) override {
     follow_units(m, now);
@@ -94,7 +93,7 @@ class UntilScan : public ScanTest {
         u.state = state;
         u.since_ns = now;
         u.timed_out = false;
-      } else if (opt_.test_timeout_ns > 0 && !u.timed_out && now + tick - u.since_ns > opt_.test_timeout_ns) {
+      } else if (opt_.test_timeout_ns > 0 && !u.timed_out && now - u.since_ns >= opt_.test_timeout_ns) {
         u.timed_out = true;
         AssertLogEntry e;
         e.unit = u.name;
@@ -121,7 +120,6 @@ UntilReport run_until(const st::Application& app, const rt::Schedule& schedule, 
                       const st::ProgramInstance& until, uint32_t reached, const UntilOptions& opt) {
   UntilReport rep;
   UntilScan scan(app, until, reached, opt, &rep);
-  scan.tick = schedule.tick_ns();
   for (const auto& f : find_instances(app, [](const st::PouInfo* p) { return p->is_stdlib && st::iequals(p->name, "FB_ASSERT"); })) {
     const st::Field* step = f.type->type->field("_faStep");
     const st::Field* name = f.type->type->field("_faName");

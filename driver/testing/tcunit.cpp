@@ -370,10 +370,10 @@ class Runner : public st::LibraryHook, public ScanTest {
     if (opt_.test_timeout_ns <= 0) return;
     for (auto& t : s.tests) {
       if (t.result.finished || t.result.disabled || t.filtered || t.started_ns < 0) continue;
-      if (now - t.started_ns + tick_ <= opt_.test_timeout_ns) continue;
+      if (now - t.started_ns < opt_.test_timeout_ns) continue;
       t.result.finished = true;
       t.result.failed = true;
-      t.result.seconds = static_cast<double>(now + tick_ - t.started_ns) / 1e9;
+      t.result.seconds = static_cast<double>(now - t.started_ns) / 1e9;
       t.result.problem = fmt::format("not finished within the per-test time-out ({}): TEST_FINISHED() was not called",
                                      common::format_duration(opt_.test_timeout_ns));
     }

@@ -6,7 +6,7 @@
 //   methods, each of which calls TEST('name') (or TEST_ORDERED), asserts, and
 //   TEST_FINISHED() when done (possibly many cycles later).
 // - RUN() (or RUN_IN_SEQUENCE()), called from the user's test program, counts its calls in
-//   _TcUnitRun/_TcUnitMode; plcfi's TcUnit runner (runtime/tcunit.cpp) then calls the body
+//   _TcUnitRun/_TcUnitMode; plcfi's TcUnit runner (testing/tcunit.cpp) then calls the body
 //   of every suite instance once per cycle until all tests finished or the time-out.
 // - The library keeps no bookkeeping: each call fills the suite's mailbox and hands it to
 //   the runner through __TCUNIT (stdlib/tcunit_abi.hpp), which applies TcUnit's rules.
@@ -383,7 +383,7 @@ END_METHOD
 // every failed assertion (and, with LogPassed, every passed one) is logged in the global
 // _fa* table, once per state and assertion unless MultipleLog is set; AbortAfterFail skips
 // every assertion after the first failure. `plcfi test --until EXPR` scans the program
-// and reads the log (runtime/fb_assert.cpp).
+// and reads the log (testing/fb_assert.cpp).
 std::string build_fb_assert() {
   std::string text = hex_function("_faHex") + R"ST(
 VAR_GLOBAL

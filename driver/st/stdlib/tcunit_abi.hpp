@@ -1,5 +1,5 @@
 // The contract between plcfi's TcUnit library (stdlib/tcunit.cpp, written in ST) and its
-// runner (runtime/tcunit.cpp): the only place both sides read it from.
+// runner (testing/tcunit.cpp): the only place both sides read it from.
 //
 // The library keeps no bookkeeping of its own. Every TcUnit call (TEST, an assertion,
 // TEST_FINISHED, ...) fills the suite instance's mailbox (the FB_TestSuite variables named
