@@ -259,72 +259,6 @@ int cmd_run(const std::vector<std::string>& args) {
 
 namespace {
 
-// TcUnit's extended results (LogExtendedResults), as its log has them after a suite ended.
-void print_tcunit_extended(const testing::TcUnitReport& rep) {
-  for (size_t i = 0; i < rep.suites.size(); ++i) {
-    const auto& s = rep.suites[i];
-    if (s.tests.empty() && s.filtered > 0) continue;  // --filter selected none of its tests
-    size_t failed = 0;
-    for (const auto& t : s.tests) failed += t.failed;
-    std::cout << fmt::format("| Test suite ID={} '{}'\n| ID={} number of tests={}, number of failed tests={}, duration={}\n", i,
-                             s.path, i, s.tests.size(), failed, testing::tcunit_seconds(s.seconds));
-    for (const auto& t : s.tests) {
-      std::cout << "| Test name=" << t.name << "\n| Test class name=" << s.path << "\n"
-                << fmt::format("| Test status={}, number of asserts={}, duration={}\n",
-                               t.disabled ? "SKIP" : t.failed ? "FAIL" : "PASS", t.asserts, testing::tcunit_seconds(t.seconds));
-      if (!t.message.empty()) std::cout << "| Test assert message=" << t.message << "\n";
-      if (!t.type.empty()) std::cout << "| Test assert type=" << t.type << "\n";
-    }
-  }
-}
-
-// What TcUnit prints besides the tests: its own messages and the program's (TCUNIT_ADSLOGSTR,
-// ADSLOGSTR) in order (the failed assertions are shown with their tests), its errors, the
-// extended results when asked, its summary. Returns false when TcUnit reported an error of
-// its own (a name used twice, more tests or assertions than the parameters allow, stopped).
-bool print_tcunit_tail(const testing::TcUnitReport& rep, bool extended) {
-  constexpr size_t kShown = 200;  // a message logged in every cycle of a long run
-  size_t shown = 0, more = 0;
-  for (const auto& l : rep.log) {
-    if (l.text.rfind("FAILED TEST '", 0) == 0) continue;
-    if (shown == kShown) {
-      ++more;
-      continue;
-    }
-    if (shown++ == 0) std::cout << "TcUnit log:\n";
-    std::cout << "  " << l.level << ": " << l.text << "\n";
-  }
-  if (more) std::cout << "  (" << more << " more messages not shown)\n";
-  bool ok = rep.own_errors == 0;
-  for (const auto& s : rep.suites)
-    if (s.registered > rep.max_tests) {
-      ok = false;
-      std::cout << fmt::format("Tests failed because the number of tests ({}) in the test suite '{}' are more than is defined "
-                               "in parameter 'GVL_Param_TcUnit.MaxNumberOfTestsForEachTestSuite' ({}). Please increase this "
-                               "parameter.\n",
-                               s.registered, s.path, rep.max_tests);
-    }
-  if (extended) print_tcunit_extended(rep);
-  size_t suites = 0, tests = 0, failed = 0;
-  for (const auto& s : rep.suites) {
-    suites += !(s.tests.empty() && s.filtered > 0);  // --filter selected none of its tests
-    for (const auto& t : s.tests) {
-      ++tests;
-      failed += t.failed;
-    }
-  }
-  std::cout << "| ==========TESTS FINISHED RUNNING==========\n"
-            << "| Test suites: " << suites << "\n"
-            << "| Tests: " << tests << "\n"
-            << "| Successful tests: " << tests - failed << "\n"
-            << "| Failed tests: " << failed << "\n"
-            << "| Duration: " << testing::tcunit_seconds(rep.seconds) << "\n"
-            << "| ======================================\n";
-  std::cout << fmt::format("TcUnit: {} of virtual time, {} cycles{}\n", common::format_duration(rep.virtual_ns), rep.cycles,
-                           rep.timed_out ? "; the time-out ended the run" : rep.aborted ? "; TcUnit stopped" : "");
-  return ok;
-}
-
 // --filter, --list, --test-timeout: the same for every kind of test.
 struct TestSelection {
   testing::Filter filter;
@@ -549,7 +483,7 @@ int cmd_test(const std::vector<std::string>& args) {
     }
     std::vector<testing::TestSuite> tc = testing::tcunit_suites(rep, *b);
     report::print_tests(std::cout, tc);
-    tcunit_ok = print_tcunit_tail(rep, vm.count("tcunit-extended") > 0);
+    tcunit_ok = report::print_tcunit_summary(std::cout, rep, vm.count("tcunit-extended") > 0);
     if (vm.count("xunit") && !report::write_tcunit_xunit(vm["xunit"].as<std::string>(), tc, rep.seconds, &err)) {
       std::cerr << "plcfi test: " << err << "\n";
       return 2;

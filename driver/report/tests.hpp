@@ -8,6 +8,7 @@
 
 #include "junit.hpp"
 #include "testing/model.hpp"
+#include "testing/tcunit.hpp"
 
 namespace plcfi::report {
 
@@ -18,6 +19,14 @@ void print_tests(std::ostream& out, const std::vector<testing::TestSuite>& suite
 std::string totals_line(const testing::Totals& t);
 // A duration as the listing shows it: 0s, 20ms, 1s500ms.
 std::string test_duration(double seconds);
+
+// What TcUnit prints besides the tests (print_tests shows those): its own messages and
+// the program's (TCUNIT_ADSLOGSTR, ADSLOGSTR) in order, its errors, its extended results
+// when asked, its summary. False when TcUnit reported an error of its own (a test name
+// used twice, more tests or assertions than GVL_Param_TcUnit allows, TcUnit stopped).
+bool print_tcunit_summary(std::ostream& out, const testing::TcUnitReport& rep, bool extended);
+// TcUnit's text of a number of seconds (LREAL_TO_STRING with a decimal point: 0.0, 0.01).
+std::string tcunit_seconds(double s);
 
 std::vector<JunitSuite> junit_suites(const std::vector<testing::TestSuite>& suites);
 bool write_test_junit(const std::string& path, const std::vector<testing::TestSuite>& suites, std::string* err);

@@ -445,12 +445,6 @@ bool Runner::after_scan(st::Machine& m, uint64_t n, int64_t now) {
 
 }  // namespace
 
-std::string tcunit_seconds(double s) {
-  std::string t = fmt::format("{}", s);
-  if (t.find_first_of(".eni") == std::string::npos) t += ".0";
-  return t;
-}
-
 bool has_tcunit_suites(const st::Application& app) { return !find_suites(app).empty(); }
 
 std::vector<std::pair<std::string, const st::PouInfo*>> tcunit_suite_instances(const st::Application& app) {

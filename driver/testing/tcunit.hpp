@@ -98,7 +98,4 @@ std::vector<std::pair<std::string, const st::PouInfo*>> tcunit_suite_instances(c
 // test and stop that suite; a trap in a scanned program stops the run.
 TcUnitReport run_tcunit(const st::Application& app, const rt::Schedule& schedule, st::Machine& m, const TcUnitOptions& opt);
 
-// TcUnit's text of a number of seconds (LREAL_TO_STRING with a decimal point: 0.0, 0.01).
-std::string tcunit_seconds(double s);
-
 }  // namespace plcfi::testing

@@ -943,6 +943,28 @@ int compare(ValueKind k, const uint8_t* a, const uint8_t* b) {
 
 namespace {
 
+bool arrays_fit(const Machine& m, const ArrayDiffShape& s, uint32_t addr_e, uint32_t addr_a) {
+  auto fits = [&](uint32_t addr, uint32_t count, uint32_t size) {
+    return addr != 0 && static_cast<uint64_t>(addr) + static_cast<uint64_t>(count) * size <= m.mem_size();
+  };
+  return fits(addr_e, s.count_e, s.elem_size) && fits(addr_a, s.count_a, s.elem_size_a);
+}
+
+// The index of the first element that differs (REALs: by more than delta), or -1.
+int64_t first_difference(const Machine& m, const ArrayDiffShape& s, uint32_t addr_e, uint32_t addr_a, double delta) {
+  const auto kind = static_cast<ValueKind>(s.kind);
+  for (uint32_t i = 0; i < s.count_e; ++i) {
+    const uint8_t* x = m.mem() + addr_e + static_cast<size_t>(i) * s.elem_size;
+    const uint8_t* y = m.mem() + addr_a + static_cast<size_t>(i) * s.elem_size_a;
+    bool same;
+    if (kind == ValueKind::F32) same = std::fabs(static_cast<double>(ld<float>(x)) - ld<float>(y)) <= delta;
+    else if (kind == ValueKind::F64) same = std::fabs(ld<double>(x) - ld<double>(y)) <= delta;
+    else same = compare(kind, x, y) == 0;
+    if (!same) return i;
+  }
+  return -1;
+}
+
 // An element as TcUnit's assertion messages show it: bit strings in hex, REALs with a
 // decimal point (-23.0).
 std::string tcunit_element(ValueKind kind, uint32_t hex_digits, const uint8_t* p) {
@@ -980,19 +1002,13 @@ std::string tcunit_array_record(Machine& m, const ArrayDiffShape& s, uint32_t ad
   bool same_shape = true;
   for (uint32_t k = 0; k < s.ndims; ++k) same_shape = same_shape && s.extent[k] == s.extent_a[k];
   if (!same_shape) return std::string("S") + sep + size_e + sep + size_a + sep + key;
-  auto fits = [&](uint32_t addr, uint32_t count, uint32_t size) {
-    return addr != 0 && static_cast<uint64_t>(addr) + static_cast<uint64_t>(count) * size <= m.mem_size();
-  };
-  if (!fits(addr_e, s.count_e, s.elem_size) || !fits(addr_a, s.count_a, s.elem_size_a))
+  if (!arrays_fit(m, s, addr_e, addr_a))
     return std::string("S") + sep + "an array outside the memory" + sep + "" + sep + key;  // not reached
-  for (uint32_t i = 0; i < s.count_e; ++i) {
+  const int64_t at = first_difference(m, s, addr_e, addr_a, delta);
+  if (at >= 0) {
+    const auto i = static_cast<uint32_t>(at);
     const uint8_t* x = m.mem() + addr_e + static_cast<size_t>(i) * s.elem_size;
     const uint8_t* y = m.mem() + addr_a + static_cast<size_t>(i) * s.elem_size_a;
-    bool same;
-    if (kind == ValueKind::F32) same = std::fabs(static_cast<double>(ld<float>(x)) - ld<float>(y)) <= delta;
-    else if (kind == ValueKind::F64) same = std::fabs(ld<double>(x) - ld<double>(y)) <= delta;
-    else same = compare(kind, x, y) == 0;
-    if (same) continue;
     std::string ie, ia;
     uint32_t rest = i;
     for (uint32_t k = s.ndims; k-- > 0;) {
@@ -1017,35 +1033,25 @@ void array_difference(Machine& m, uint32_t cap, uint8_t* out, uint8_t* blk, uint
   const double delta = ld<double>(blk + 8);
   const auto kind = static_cast<ValueKind>(s.kind);
   std::string msg;
-  auto fits = [&](uint32_t addr, uint32_t count, uint32_t size) {
-    return addr != 0 && static_cast<uint64_t>(addr) + static_cast<uint64_t>(count) * size <= m.mem_size();
-  };
   if (s.style == 1) {
     msg = tcunit_array_record(m, s, addr_e, addr_a, delta);
   } else if (s.count_e != s.count_a) {
     msg = fmt::format("EXP: an array of {} elements, ACT: {} elements", s.count_e, s.count_a);
-  } else if (!fits(addr_e, s.count_e, s.elem_size) || !fits(addr_a, s.count_a, s.elem_size_a)) {
+  } else if (!arrays_fit(m, s, addr_e, addr_a)) {
     msg = "an array outside the memory";  // the compiler passes whole arrays: not reached
-  } else {
-    for (uint32_t i = 0; i < s.count_e; ++i) {
-      const uint8_t* x = m.mem() + addr_e + static_cast<size_t>(i) * s.elem_size;
-      const uint8_t* y = m.mem() + addr_a + static_cast<size_t>(i) * s.elem_size_a;
-      bool same;
-      if (kind == ValueKind::F32) same = std::fabs(static_cast<double>(ld<float>(x)) - ld<float>(y)) <= delta;
-      else if (kind == ValueKind::F64) same = std::fabs(ld<double>(x) - ld<double>(y)) <= delta;
-      else same = compare(kind, x, y) == 0;
-      if (same) continue;
-      // The element's index in the expected array, one number per dimension (row-major).
-      std::string index;
-      uint32_t rest = i;
-      for (uint32_t k = s.ndims; k-- > 0;) {
-        const uint32_t ext = s.extent[k] ? s.extent[k] : 1;
-        index = fmt::format("{}{}", static_cast<int64_t>(s.lo[k]) + rest % ext, index.empty() ? "" : "," + index);
-        rest /= ext;
-      }
-      msg = fmt::format("EXP: {}, ACT: {} at [{}]", format_value(kind, x), format_value(kind, y), index);
-      break;
+  } else if (const int64_t at = first_difference(m, s, addr_e, addr_a, delta); at >= 0) {
+    const auto i = static_cast<uint32_t>(at);
+    const uint8_t* x = m.mem() + addr_e + static_cast<size_t>(i) * s.elem_size;
+    const uint8_t* y = m.mem() + addr_a + static_cast<size_t>(i) * s.elem_size_a;
+    // The element's index in the expected array, one number per dimension (row-major).
+    std::string index;
+    uint32_t rest = i;
+    for (uint32_t k = s.ndims; k-- > 0;) {
+      const uint32_t ext = s.extent[k] ? s.extent[k] : 1;
+      index = fmt::format("{}{}", static_cast<int64_t>(s.lo[k]) + rest % ext, index.empty() ? "" : "," + index);
+      rest /= ext;
     }
+    msg = fmt::format("EXP: {}, ACT: {} at [{}]", format_value(kind, x), format_value(kind, y), index);
   }
   const size_t n = std::min<size_t>(msg.size(), cap);
   std::memcpy(out, msg.data(), n);
