@@ -311,6 +311,34 @@ bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt
   return ok;
 }
 
+// The TcUnit suites: run, printed, TcUnit's summary and xUnit file; their results join
+// `suites`. Returns an exit status when the run cannot be reported (0: go on).
+int run_tcunit_suites(const st::Build& b, const po::variables_map& vm, const rt::Schedule& sched, st::Machine& m,
+                      int64_t timeout_ns, const TestSelection& sel, std::vector<testing::TestSuite>* suites, bool* ok) {
+  testing::TcUnitOptions to;
+  to.timeout_ns = timeout_ns;
+  to.test_timeout_ns = sel.test_timeout_ns;
+  to.filter = &sel.filter;
+  to.budget = vm["budget"].as<Count>().value;
+  const testing::TcUnitReport rep = testing::run_tcunit(*b.app, sched, m, to);
+  if (!rep.program_trap.empty()) std::cerr << rep.program_trap << "\n";
+  if (!rep.run_called) {
+    std::cerr << "plcfi test: TcUnit.RUN() was not called within " << common::format_duration(to.timeout_ns)
+              << ": call it in the program that holds the suites (e.g. PRG_TEST, called by a task)\n";
+    return 1;
+  }
+  std::vector<testing::TestSuite> tc = testing::tcunit_suites(rep, b);
+  report::print_tests(std::cout, tc);
+  *ok = report::print_tcunit_summary(std::cout, rep, vm.count("tcunit-extended") > 0);
+  std::string err;
+  if (vm.count("xunit") && !report::write_tcunit_xunit(vm["xunit"].as<std::string>(), tc, rep.seconds, &err)) {
+    std::cerr << "plcfi test: " << err << "\n";
+    return 2;
+  }
+  for (auto& s : tc) suites->push_back(std::move(s));
+  return 0;
+}
+
 // `plcfi test --until EXPR`: the program scans until EXPR holds; then FB_ASSERT's log is
 // reported, one group per unit under test. EXPR is compiled as a PROGRAM linked onto the
 // program, so it reaches every instance by path.
@@ -469,26 +497,7 @@ int cmd_test(const std::vector<std::string>& args) {
   }
   bool tcunit_ok = true;
   if (tcunit) {
-    testing::TcUnitOptions to;
-    to.timeout_ns = timeout_ns;
-    to.test_timeout_ns = sel.test_timeout_ns;
-    to.filter = &sel.filter;
-    to.budget = vm["budget"].as<Count>().value;
-    const testing::TcUnitReport rep = testing::run_tcunit(app, sched, m, to);
-    if (!rep.program_trap.empty()) std::cerr << rep.program_trap << "\n";
-    if (!rep.run_called) {
-      std::cerr << "plcfi test: TcUnit.RUN() was not called within " << common::format_duration(to.timeout_ns)
-                << ": call it in the program that holds the suites (e.g. PRG_TEST, called by a task)\n";
-      return 1;
-    }
-    std::vector<testing::TestSuite> tc = testing::tcunit_suites(rep, *b);
-    report::print_tests(std::cout, tc);
-    tcunit_ok = report::print_tcunit_summary(std::cout, rep, vm.count("tcunit-extended") > 0);
-    if (vm.count("xunit") && !report::write_tcunit_xunit(vm["xunit"].as<std::string>(), tc, rep.seconds, &err)) {
-      std::cerr << "plcfi test: " << err << "\n";
-      return 2;
-    }
-    for (auto& s : tc) suites.push_back(std::move(s));
+    if (int status = run_tcunit_suites(*b, vm, sched, m, timeout_ns, sel, &suites, &tcunit_ok); status != 0) return status;
   } else if (vm.count("xunit")) {
     std::cerr << "plcfi test: --xunit writes TcUnit's xUnit file: there are no TcUnit suites among the inputs (use --junit)\n";
     return 2;
