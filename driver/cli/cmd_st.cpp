@@ -1,6 +1,7 @@
 // ST engine commands: check, run, test, disasm.
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -259,6 +260,34 @@ int cmd_run(const std::vector<std::string>& args) {
 
 namespace {
 
+// --tcunit-param KEY=VALUE, each checked against TcUnit's parameter list.
+bool tcunit_params(const po::variables_map& vm, std::vector<std::pair<std::string, std::string>>* out) {
+  if (!vm.count("tcunit-param")) return true;
+  for (const auto& kv : vm["tcunit-param"].as<std::vector<std::string>>()) {
+    const auto eq = kv.find('=');
+    const std::string key = kv.substr(0, eq), value = eq == std::string::npos ? "" : kv.substr(eq + 1);
+    std::string why = eq == std::string::npos ? "give KEY=VALUE" : st::tcunit_param_error(key, value);
+    if (!why.empty()) {
+      std::cerr << "plcfi test: --tcunit-param " << kv << ": " << why << "\n";
+      return false;
+    }
+    out->emplace_back(key, value);
+  }
+  return true;
+}
+
+// A TcUnit parameter the project or the command line set (the last setting), if any.
+std::optional<std::string> tcunit_param_set(const st::Build& b, const st::CompileOptions& opt, const char* key) {
+  std::optional<std::string> v;
+  for (const auto& p : b.library_params)
+    if (st::iequals(p.list, "GVL_Param_TcUnit") && st::iequals(p.key, key)) v = p.value;
+  for (const auto& [k, value] : opt.tcunit_params)
+    if (st::iequals(k, key)) v = value;
+  return v;
+}
+
+bool is_true(const std::optional<std::string>& v) { return v && (st::iequals(*v, "TRUE") || *v == "1"); }
+
 // --filter, --list, --test-timeout: the same for every kind of test.
 struct TestSelection {
   testing::Filter filter;
@@ -313,8 +342,9 @@ bool tcunit_schedule(const st::Application& app, const po::variables_map& vm, rt
 
 // The TcUnit suites: run, printed, TcUnit's summary and xUnit file; their results join
 // `suites`. Returns an exit status when the run cannot be reported (0: go on).
-int run_tcunit_suites(const st::Build& b, const po::variables_map& vm, const rt::Schedule& sched, st::Machine& m,
-                      int64_t timeout_ns, const TestSelection& sel, std::vector<testing::TestSuite>* suites, bool* ok) {
+int run_tcunit_suites(const st::Build& b, const st::CompileOptions& opt, const po::variables_map& vm, const rt::Schedule& sched,
+                      st::Machine& m, int64_t timeout_ns, const TestSelection& sel, std::vector<testing::TestSuite>* suites,
+                      bool* ok) {
   testing::TcUnitOptions to;
   to.timeout_ns = timeout_ns;
   to.test_timeout_ns = sel.test_timeout_ns;
@@ -329,9 +359,21 @@ int run_tcunit_suites(const st::Build& b, const po::variables_map& vm, const rt:
   }
   std::vector<testing::TestSuite> tc = testing::tcunit_suites(rep, b);
   report::print_tests(std::cout, tc);
-  *ok = report::print_tcunit_summary(std::cout, rep, vm.count("tcunit-extended") > 0);
+  // TcUnit's LogExtendedResults and xUnitEnablePublish, when the project (or
+  // --tcunit-param) sets them; plcfi prints the extended results only when asked otherwise.
+  const bool extended = vm.count("tcunit-extended") || is_true(tcunit_param_set(b, opt, "LogExtendedResults"));
+  *ok = report::print_tcunit_summary(std::cout, rep, extended);
+  std::string xunit = vm.count("xunit") ? vm["xunit"].as<std::string>() : "";
+  if (xunit.empty() && is_true(tcunit_param_set(b, opt, "xUnitEnablePublish"))) {
+    // xUnitFilePath, its TwinCAT folder variables read as the current folder.
+    xunit = tcunit_param_set(b, opt, "xUnitFilePath").value_or("%TC_BOOTPRJPATH%tcunit_xunit_testresults.xml");
+    for (const char* var : {"%TC_BOOTPRJPATH%", "%TC_INSTALLPATH%"})
+      for (size_t at; (at = xunit.find(var)) != std::string::npos;) xunit.erase(at, std::strlen(var));
+    std::replace(xunit.begin(), xunit.end(), '\\', '/');
+    std::cout << "TcUnit: xUnit file " << xunit << " (xUnitEnablePublish)\n";
+  }
   std::string err;
-  if (vm.count("xunit") && !report::write_tcunit_xunit(vm["xunit"].as<std::string>(), tc, rep.seconds, &err)) {
+  if (!xunit.empty() && !report::write_tcunit_xunit(xunit, tc, rep.seconds, &err)) {
     std::cerr << "plcfi test: " << err << "\n";
     return 2;
   }
@@ -438,6 +480,7 @@ int cmd_test(const std::vector<std::string>& args) {
       ("program", po::value<std::string>(), "TcUnit: the program to scan (the one calling TcUnit.RUN()) when there is no task configuration or to run it alone")
       ("cycle-time", po::value<std::string>()->default_value("10ms"), "TcUnit: cycle time of that program")
       ("tcunit-extended", "TcUnit: print its extended results too (per suite and test: status, number of assertions, duration)")
+      ("tcunit-param", po::value<std::vector<std::string>>(), "TcUnit: set one of its library parameters (GVL_Param_TcUnit), KEY=VALUE, after the project's own (e.g. MaxNumberOfTestsForEachTestSuite=200; repeatable)")
       ("xunit", po::value<std::string>(), "TcUnit: write the xUnit XML file TcUnit publishes (testsuites, testcase status PASS/FAIL/SKIP, durations)")
       ("filter", po::value<std::vector<std::string>>(), "run (or list) only the tests this shell pattern matches: their suite's name (test file, TcUnit instance path, FB_ASSERT unit), their own name or SUITE/TEST (repeatable)")
       ("list", "list the tests (SUITE/TEST) the run would run, and run none")
@@ -458,6 +501,7 @@ int cmd_test(const std::vector<std::string>& args) {
   if (!test_selection(vm, &sel)) return 2;
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
+  if (!tcunit_params(vm, &opt.tcunit_params)) return 2;
   opt.test_mode = true;
   opt.warnings = false;
   auto b = load(strings_of(vm, "files"), opt, "test");
@@ -497,7 +541,8 @@ int cmd_test(const std::vector<std::string>& args) {
   }
   bool tcunit_ok = true;
   if (tcunit) {
-    if (int status = run_tcunit_suites(*b, vm, sched, m, timeout_ns, sel, &suites, &tcunit_ok); status != 0) return status;
+    if (int status = run_tcunit_suites(*b, opt, vm, sched, m, timeout_ns, sel, &suites, &tcunit_ok); status != 0)
+      return status;
   } else if (vm.count("xunit")) {
     std::cerr << "plcfi test: --xunit writes TcUnit's xUnit file: there are no TcUnit suites among the inputs (use --junit)\n";
     return 2;

@@ -208,7 +208,16 @@ std::unique_ptr<Build> finish(std::unique_ptr<Build> b, std::vector<uint32_t> fi
       files.insert(files.begin() + 1, b->sm.add("<Tc2_System>", sys));
   }
   if (uses_library(b->sm, files, "fb_testsuite")) {
-    files.insert(files.begin() + 1, b->sm.add("<TcUnit>/GVL_Param_TcUnit", tcunit_params_source()));
+    // TcUnit's parameters: the projects' settings (each checked at its place), then the
+    // command line's.
+    std::vector<std::pair<std::string, std::string>> values;
+    for (const auto& p : b->library_params) {
+      if (!iequals(p.list, "GVL_Param_TcUnit")) continue;
+      if (std::string why = tcunit_param_error(p.key, p.value); !why.empty()) b->diags.error("ST625", p.loc, why);
+      else values.emplace_back(p.key, p.value);
+    }
+    for (const auto& kv : opt.tcunit_params) values.push_back(kv);
+    files.insert(files.begin() + 1, b->sm.add("<TcUnit>/GVL_Param_TcUnit", tcunit_params_source(values)));
     files.insert(files.begin() + 1, b->sm.add("<TcUnit>", tcunit_source()));
   }
   if (uses_library(b->sm, files, "fb_assert")) files.insert(files.begin() + 1, b->sm.add("<FB_ASSERT>", fb_assert_source()));
@@ -249,7 +258,7 @@ std::unique_ptr<Build> build_files(const std::vector<std::string>& paths, const 
     if (InputKind kind = input_kind(p); kind != InputKind::St) {
       const size_t first = files.size();
       if (kind == InputKind::PlcopenXml) import_plcopen(p, b->sm, b->diags, &files);
-      else import_twincat(p, b->sm, b->diags, &files);
+      else import_twincat(p, b->sm, b->diags, &files, &b->library_params);
       imported.insert(files.begin() + static_cast<ptrdiff_t>(first), files.end());
       return;
     }

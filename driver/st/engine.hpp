@@ -26,6 +26,7 @@ struct Build {
   std::vector<std::unique_ptr<CompilationUnit>> late;  // monitors
   std::unique_ptr<Application> app;
   std::vector<std::string> io_errors;  // files that could not be read
+  std::vector<LibraryParam> library_params;  // set by the projects read (TwinCAT's library parameters)
 
   bool ok() const { return app != nullptr; }
 };

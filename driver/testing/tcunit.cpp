@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cstring>
 #include <map>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -115,6 +116,7 @@ struct LiveSuite {
   // test path, message and key; the cycle the counts are of.
   AssertTable asserts, array_asserts;
   uint64_t counted_cycle = UINT64_MAX;
+  std::set<std::string> beyond;  // names of tests over MaxNumberOfTestsForEachTestSuite
   bool started = false, done = false, stopped = false;
   int64_t started_ns = -1;
   double seconds = 0;
@@ -148,7 +150,8 @@ class Runner : public st::LibraryHook, public ScanTest {
     now_ns_ = now_ns;
   }
   void set_tick(int64_t tick) { tick_ = tick; }
-  void set_params(const st::Symbol* max_tests, const st::Symbol* max_asserts) {
+  void set_params(const st::Symbol* max_suites, const st::Symbol* max_tests, const st::Symbol* max_asserts) {
+    max_suites_sym_ = max_suites;
     max_tests_sym_ = max_tests;
     max_asserts_sym_ = max_asserts;
   }
@@ -242,9 +245,12 @@ class Runner : public st::LibraryHook, public ScanTest {
         }
       }
       t->touched = cycle_;
+    } else if (s.tests.size() >= max_tests_) {
+      s.beyond.insert(name);  // TcUnit keeps no more: counted, not run
+      s.registered = static_cast<uint32_t>(s.tests.size() + s.beyond.size());
     } else {
       ++s.registered;
-      if (s.tests.size() < max_tests_) {
+      {
         LiveTest n;
         n.result.name = name;
         n.result.disabled = disabled;
@@ -362,7 +368,7 @@ class Runner : public st::LibraryHook, public ScanTest {
   const TcUnitOptions& opt_;
   const st::Symbol *run_ = nullptr, *mode_ = nullptr, *pause_ = nullptr;
   int64_t first_run_ns_ = -1, next_start_ns_ = 0, tick_ = 0;
-  const st::Symbol *max_tests_sym_ = nullptr, *max_asserts_sym_ = nullptr;
+  const st::Symbol *max_suites_sym_ = nullptr, *max_tests_sym_ = nullptr, *max_asserts_sym_ = nullptr;
 
   // --test-timeout: a test not finished that long after its first TEST call fails and is
   // finished (its later assertions are ignored), so the suite goes on.
@@ -403,6 +409,13 @@ bool Runner::after_scan(st::Machine& m, uint64_t n, int64_t now) {
     rep_->max_tests = param(max_tests_sym_, m, 100);
     rep_->max_asserts = param(max_asserts_sym_, m, 1000);
     set_limits(rep_->max_tests, rep_->max_asserts);
+    const uint32_t max_suites = param(max_suites_sym_, m, 1000);
+    if (suites_.size() > max_suites) {  // TcUnit would write past its table: plcfi runs the first ones
+      log("error", fmt::format("{} test suites are more than GVL_Param_TcUnit.MaxNumberOfTestSuites ({}): the ones "
+                               "after {} do not run",
+                               suites_.size(), max_suites, suites_[max_suites - 1].at.path));
+      suites_.resize(max_suites);
+    }
   }
   for (auto& e : m.log()) rep_->log.push_back(TcUnitLogLine{e.level, e.text});  // the program's ADSLOGSTR
   m.log().clear();
@@ -475,7 +488,8 @@ TcUnitReport run_tcunit(const st::Application& app, const rt::Schedule& schedule
     st::Machine& m;
     ~Unhook() { m.set_hook(nullptr); }
   } unhook{m};
-  runner.set_params(global(app, "MaxNumberOfTestsForEachTestSuite", "GVL_Param_TcUnit"),
+  runner.set_params(global(app, "MaxNumberOfTestSuites", "GVL_Param_TcUnit"),
+                    global(app, "MaxNumberOfTestsForEachTestSuite", "GVL_Param_TcUnit"),
                     global(app, "MaxNumberOfAssertsForEachTestSuite", "GVL_Param_TcUnit"));
   runner.set_tick(schedule.tick_ns());
   const ScanRun scans = run_scans(app, schedule, m, runner, opt.timeout_ns, opt.budget);

@@ -30,6 +30,9 @@ struct CompileOptions {
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.
   std::vector<std::string> library_files;
+  // TcUnit's parameters set on the command line (--tcunit-param KEY=VALUE), after the
+  // project's own: checked with tcunit_param_error before.
+  std::vector<std::pair<std::string, std::string>> tcunit_params;
 };
 
 // Compiles the units (and test files) together with the standard library. Returns null
@@ -53,9 +56,21 @@ const char* stdlib_source();
 // The TcUnit framework's ST source (FB_TestSuite, RUN), compiled with an application whose
 // sources use it (stdlib/tcunit.cpp).
 const char* tcunit_source();
+// A library parameter a project sets (TwinCAT's library manager writes them into the
+// .plcproj): list and key as written (TwinCAT upper-cases them), the value's text, and
+// where the setting is.
+struct LibraryParam {
+  std::string list, key, value;
+  SourceLoc loc;
+};
+
 // TcUnit's parameter list GVL_Param_TcUnit (loaded as "<TcUnit>/GVL_Param_TcUnit", whose
-// stem is the list's name), with TcUnit's defaults.
-const char* tcunit_params_source();
+// stem is the list's name): TcUnit's defaults, or the values given by key (any case, as a
+// project's <Parameters> or --tcunit-param set them). Check each one first with
+// tcunit_param_error.
+std::string tcunit_params_source(const std::vector<std::pair<std::string, std::string>>& values = {});
+// Why TcUnit's parameter `key` cannot take `value` ("" when it can).
+std::string tcunit_param_error(const std::string& key, const std::string& value);
 // FB_ASSERT (the assertion-FB style of TwinCAT unit tests), compiled with an application
 // whose sources use it (stdlib/tcunit.cpp).
 const char* fb_assert_source();

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "syntax/diag.hpp"
+#include "codegen/compiler.hpp"
 #include "syntax/source.hpp"
 
 namespace plcfi::st {
@@ -34,6 +35,9 @@ bool library_sources(const std::string& dir, std::vector<std::string>* files, st
 // are reported through `diags` at their place in that file. Returns false when any error
 // was reported; the units added so far stay in `units`.
 bool import_plcopen(const std::string& path, SourceManager& sm, DiagEngine& diags, std::vector<uint32_t>* units);
-bool import_twincat(const std::string& path, SourceManager& sm, DiagEngine& diags, std::vector<uint32_t>* units);
+// A TwinCAT project's library parameters (<PlaceholderReference> <Parameters> <Parameter
+// ListName="GVL_PARAM_TCUNIT"><Key>..</Key><Value>..</Value>) are appended to `params`.
+bool import_twincat(const std::string& path, SourceManager& sm, DiagEngine& diags, std::vector<uint32_t>* units,
+                    std::vector<LibraryParam>* params = nullptr);
 
 }  // namespace plcfi::st

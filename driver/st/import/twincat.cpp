@@ -93,8 +93,8 @@ struct XmlFile {
 
 class Importer {
  public:
-  Importer(SourceManager& sm, DiagEngine& diags, std::vector<uint32_t>* units)
-      : sm_(sm), diags_(diags), units_(units) {}
+  Importer(SourceManager& sm, DiagEngine& diags, std::vector<uint32_t>* units, std::vector<LibraryParam>* params)
+      : sm_(sm), diags_(diags), units_(units), params_(params) {}
 
   void run(const std::string& path);
 
@@ -120,6 +120,7 @@ class Importer {
   SourceManager& sm_;
   DiagEngine& diags_;
   std::vector<uint32_t>* units_;
+  std::vector<LibraryParam>* params_;
   std::vector<Task> tasks_;
   std::set<std::string> seen_;  // object files already read (a project listing one twice)
 };
@@ -254,7 +255,8 @@ SourceLoc Importer::loc_of(const XmlFile& f, const pugi::xml_node& n) const {
 }
 
 // <Project> <ItemGroup> <Compile Include="POUs\MAIN.TcPOU"/> ...: every listed object
-// file; other items (library references, folders, placeholders) are not ours to read.
+// file, and the parameters the project sets on its library references; other items
+// (folders, the references themselves) are not ours to read.
 void Importer::read_project(XmlFile& f) {
   pugi::xml_node project = f.doc.document_element();
   if (std::string_view(project.name()) != "Project") {
@@ -265,6 +267,11 @@ void Importer::read_project(XmlFile& f) {
   }
   const fs::path dir = fs::path(f.path).parent_path();
   for (pugi::xml_node group : project.children("ItemGroup")) {
+    for (pugi::xml_node ref : group.children())
+      for (pugi::xml_node param : ref.child("Parameters").children("Parameter"))
+        if (params_)
+          params_->push_back(LibraryParam{param.attribute("ListName").value(), param.child_value("Key"),
+                                          param.child_value("Value"), loc_of(f, param)});
     for (pugi::xml_node item : group.children("Compile")) {
       std::string include = item.attribute("Include").value();
       SourceLoc where = loc_of(f, item);
@@ -548,9 +555,10 @@ void Importer::add_configuration(const std::string& path, SourceLoc loc, const s
 
 }  // namespace
 
-bool import_twincat(const std::string& path, SourceManager& sm, DiagEngine& diags, std::vector<uint32_t>* units) {
+bool import_twincat(const std::string& path, SourceManager& sm, DiagEngine& diags, std::vector<uint32_t>* units,
+                    std::vector<LibraryParam>* params) {
   const size_t errors_before = diags.error_count();
-  Importer imp(sm, diags, units);
+  Importer imp(sm, diags, units, params);
   imp.run(path);
   return diags.error_count() == errors_before;
 }

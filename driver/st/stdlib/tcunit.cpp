@@ -18,7 +18,10 @@
 //
 // The same file builds FB_ASSERT, the older assertion-FB style of TwinCAT unit tests (see
 // fb_assert_source below): it shares the table of elementary types and their texts.
+#include <cctype>
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "codegen/compiler.hpp"
@@ -541,22 +544,99 @@ const char* fb_assert_source() {
   return text.c_str();
 }
 
-const char* tcunit_params_source() {
-  // TcUnit's parameters. The runner reads the maximum counts; the xUnit file is written
-  // with plcfi test --xunit FILE, and messages are printed as they come (no ADS queue).
-  return R"ST({attribute 'qualified_only'}
-VAR_GLOBAL CONSTANT
-  MaxNumberOfTestSuites : UINT := 1000;
-  MaxNumberOfTestsForEachTestSuite : UINT := 100;
-  MaxNumberOfAssertsForEachTestSuite : UINT := 1000;
-  LogExtendedResults : BOOL := TRUE;
-  xUnitEnablePublish : BOOL := FALSE;
-  xUnitBufferSize : UDINT := 65535;
-  xUnitFilePath : STRING(255) := '%TC_BOOTPRJPATH%tcunit_xunit_testresults.xml';
-  AdsLogMessageFifoRingBufferSize : UINT := 2000;
-  TimeBetweenTestSuitesExecution : TIME := T#0MS;
-END_VAR
-)ST";
+namespace {
+
+// GVL_Param_TcUnit: TcUnit's parameters, their types and defaults (ST literals).
+struct Param {
+  const char* name;
+  char kind;  // U: UINT, D: UDINT, B: BOOL, S: STRING, T: TIME
+  const char* value;
+};
+const Param kParams[] = {
+    {"MaxNumberOfTestSuites", 'U', "1000"},
+    {"MaxNumberOfTestsForEachTestSuite", 'U', "100"},
+    {"MaxNumberOfAssertsForEachTestSuite", 'U', "1000"},
+    {"LogExtendedResults", 'B', "TRUE"},
+    {"xUnitEnablePublish", 'B', "FALSE"},
+    {"xUnitBufferSize", 'D', "65535"},
+    {"xUnitFilePath", 'S', "'%TC_BOOTPRJPATH%tcunit_xunit_testresults.xml'"},
+    {"AdsLogMessageFifoRingBufferSize", 'U', "2000"},
+    {"TimeBetweenTestSuitesExecution", 'T', "T#0MS"},
+};
+
+const Param* find_param(const std::string& key) {
+  for (const auto& p : kParams)
+    if (iequals(p.name, key)) return &p;
+  return nullptr;
+}
+
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// The value's ST literal (its text checked by tcunit_param_error).
+std::string literal(const Param& p, const std::string& v) {
+  switch (p.kind) {
+    case 'B': return upper(v) == "TRUE" || v == "1" ? "TRUE" : "FALSE";
+    case 'S': {
+      std::string out = "'";
+      for (char c : v) out += c == '\'' ? std::string("$'") : c == '$' ? std::string("$$") : std::string(1, c);
+      return out + "'";
+    }
+    default: return v;
+  }
+}
+
+}  // namespace
+
+std::string tcunit_param_error(const std::string& key, const std::string& value) {
+  const Param* p = find_param(key);
+  if (!p) {
+    std::string names;
+    for (const auto& q : kParams) names += (names.empty() ? "" : ", ") + std::string(q.name);
+    return "TcUnit has no parameter '" + key + "' in GVL_Param_TcUnit (it has " + names + ")";
+  }
+  auto bad = [&](const char* what) { return "TcUnit's parameter " + std::string(p->name) + " takes " + what + ", not '" + value + "'"; };
+  switch (p->kind) {
+    case 'U':
+    case 'D': {
+      if (value.empty() || value.size() > 10 || value.find_first_not_of("0123456789") != std::string::npos) return bad("a whole number");
+      const uint64_t n = std::stoull(value);
+      if (n == 0 || n > (p->kind == 'U' ? 65535u : 4294967295u)) return bad(p->kind == 'U' ? "a number from 1 to 65535" : "a number from 1 to 4294967295");
+      return "";
+    }
+    case 'B': {
+      const std::string u = upper(value);
+      return u == "TRUE" || u == "FALSE" || u == "1" || u == "0" ? "" : bad("TRUE or FALSE");
+    }
+    case 'T': {
+      const std::string u = upper(value);
+      const size_t hash = u.find('#');
+      const std::string prefix = hash == std::string::npos ? "" : u.substr(0, hash);
+      if ((prefix != "T" && prefix != "TIME") || hash + 1 >= u.size() ||
+          u.find_first_not_of("0123456789DHMSU_.", hash + 1) != std::string::npos)
+        return bad("a TIME literal (T#500MS)");
+      return "";
+    }
+    default: return value.size() > 255 ? bad("a text of at most 255 characters") : "";
+  }
+}
+
+std::string tcunit_params_source(const std::vector<std::pair<std::string, std::string>>& values) {
+  // The runner reads the maximum counts; the xUnit file is written with --xunit FILE (or
+  // where xUnitFilePath says, when a project enables xUnitEnablePublish); messages are
+  // printed as they come (no ADS queue).
+  std::string text = "{attribute 'qualified_only'}\nVAR_GLOBAL CONSTANT\n";
+  for (const auto& p : kParams) {
+    std::string v = p.value;
+    for (const auto& [key, value] : values)  // the last setting wins
+      if (iequals(key, p.name)) v = literal(p, value);
+    static const char* const types[] = {"UINT", "UDINT", "BOOL", "STRING(255)", "TIME"};
+    const char* type = p.kind == 'U' ? types[0] : p.kind == 'D' ? types[1] : p.kind == 'B' ? types[2] : p.kind == 'S' ? types[3] : types[4];
+    text += "  " + std::string(p.name) + " : " + type + " := " + v + ";\n";
+  }
+  return text + "END_VAR\n";
 }
 
 const char* tcunit_source() {
