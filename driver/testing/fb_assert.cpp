@@ -116,6 +116,20 @@ class UntilScan : public ScanTest {
 
 bool has_fb_assert(const st::Application& app) { return log_of(app).ok; }
 
+std::vector<std::string> fb_assert_units(const st::Application& app, st::Machine& m, std::string* trap) {
+  std::vector<std::string> out;
+  if (!m.cold_restart()) {
+    *trap = st::describe_trap(app, m.trap()) + " (in FB_init/FB_exit at the restart)";
+    return out;
+  }
+  for (const auto& f : find_instances(app, [](const st::PouInfo* p) { return p->is_stdlib && st::iequals(p->name, "FB_ASSERT"); }))
+    if (const st::Field* name = f.type->type->field("_faName")) {
+      std::string unit = text_at(m.mem(), f.addr + name->offset, name->type->size);
+      if (std::find(out.begin(), out.end(), unit) == out.end()) out.push_back(std::move(unit));
+    }
+  return out;
+}
+
 UntilReport run_until(const st::Application& app, const rt::Schedule& schedule, st::Machine& m,
                       const st::ProgramInstance& until, uint32_t reached, const UntilOptions& opt) {
   UntilReport rep;

@@ -48,6 +48,11 @@ struct UntilOptions {
 // True when the application holds the FB_ASSERT library.
 bool has_fb_assert(const st::Application& app);
 
+// The units under test (the names FB_init gives the FB_ASSERT instances), as a cold
+// restart of m leaves them, without a scan: what --list shows. Empty with *trap set when
+// FB_init trapped.
+std::vector<std::string> fb_assert_units(const st::Application& app, st::Machine& m, std::string* trap);
+
 // Runs machine m (cold-restarted first) until the BOOL at `reached` (an output of the
 // observer program `until`, called after every cycle's programs) is TRUE.
 UntilReport run_until(const st::Application& app, const rt::Schedule& schedule, st::Machine& m,

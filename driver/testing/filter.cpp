@@ -27,4 +27,13 @@ bool Filter::may_select_suite(const std::string& suite) const {
   return false;
 }
 
+bool Filter::names_suite(const std::string& suite) const {
+  if (globs_.empty()) return true;
+  for (const auto& g : globs_) {
+    const auto slash = g.rfind('/');
+    if (glob(g, suite) || (slash != std::string::npos && glob(g.substr(0, slash), suite))) return true;
+  }
+  return false;
+}
+
 }  // namespace plcfi::testing

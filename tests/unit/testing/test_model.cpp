@@ -22,6 +22,9 @@ TEST(TestFilter, MatchesSuiteTestOrBoth) {
   const ::plcfi::testing::Filter g({"PRG_TEST.fbBlink/*"});
   EXPECT_TRUE(g.may_select_suite("PRG_TEST.fbBlink"));
   EXPECT_FALSE(g.may_select_suite("PRG_TEST.fbSum"));
+  EXPECT_TRUE(g.names_suite("PRG_TEST.fbBlink"));
+  EXPECT_FALSE(f.names_suite("PRG_TEST.fbSum"));  // *Array* names tests, not this suite
+  EXPECT_TRUE(f.names_suite("tests/a.st"));
 }
 
 TEST(TestReport, TotalsDurationsAndListing) {
