@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "common/duration.hpp"
 #include "engine.hpp"
 #include "io/bench/bench_io.hpp"
 #include "io/io_config.hpp"
@@ -19,6 +20,7 @@
 #include "options.hpp"
 #include "plant_model/plant.hpp"
 #include "report/junit.hpp"
+#include "report/tests.hpp"
 #include "report/trace.hpp"
 #include "runtime/realtime.hpp"
 #include "runtime/schedule.hpp"
@@ -26,6 +28,8 @@
 #include "script/cpt.hpp"
 #include "script/history.hpp"
 #include "script/runner.hpp"
+#include "testing/filter.hpp"
+#include "testing/model.hpp"
 #include "trace_hook.hpp"
 
 namespace po = boost::program_options;
@@ -108,12 +112,136 @@ bool write_csv_log(const std::string& path, const script::ScriptResult& r, std::
 
 double number_option(const po::variables_map& vm, const char* key) { return vm[key].as<double>(); }
 
+// --filter, --list, --test-timeout and --timeout: which scripts run, and for how long.
+struct Selection {
+  testing::Filter filter;
+  bool list = false;
+  int64_t test_timeout_ns = 0;  // per script, on its scan clock; 0: none
+  int64_t timeout_ns = 0;       // all scripts together; 0: none
+};
+
+// An optional duration option that must be positive.
+bool positive_duration(const po::variables_map& vm, const char* key, int64_t* ns) {
+  if (!vm.count(key)) return true;
+  const std::string text = vm[key].as<std::string>();
+  std::string err;
+  if (rt::parse_duration(text, ns, &err) && *ns > 0) return true;
+  std::cerr << "plcfi script: --" << key << ": " << (err.empty() ? "must be positive, got '" + text + "'" : err) << "\n";
+  return false;
+}
+
+bool selection_of(const po::variables_map& vm, Selection* sel) {
+  if (vm.count("filter")) sel->filter = testing::Filter(vm["filter"].as<std::vector<std::string>>());
+  sel->list = vm.count("list") > 0;
+  return positive_duration(vm, "test-timeout", &sel->test_timeout_ns) && positive_duration(vm, "timeout", &sel->timeout_ns);
+}
+
+// The scripts --filter selects: the suite is the script's path as given, the test its name.
+std::vector<size_t> selected_scripts(const std::vector<script::Script>& parsed, const testing::Filter& filter) {
+  std::vector<size_t> out;
+  for (size_t i = 0; i < parsed.size(); ++i)
+    if (filter.selects(parsed[i].path, parsed[i].name)) out.push_back(i);
+  return out;
+}
+
+// The scan-clock time a script may take, into ro: the per-test time-out or what is left of
+// the run's, whichever is less. False when the run's is used up: the script does not start.
+bool limit_time(const Selection& sel, int64_t used_ns, script::RunOptions* ro) {
+  ro->time_limit_ns = sel.test_timeout_ns;
+  ro->time_limit_reason =
+      fmt::format("did not finish within the per-test time-out ({})", common::format_duration(sel.test_timeout_ns));
+  if (sel.timeout_ns == 0) return true;
+  const int64_t left = sel.timeout_ns - used_ns;
+  if (left <= 0) return false;
+  if (ro->time_limit_ns == 0 || left < ro->time_limit_ns) {
+    ro->time_limit_ns = left;
+    ro->time_limit_reason = fmt::format("did not finish within the run's time-out ({})", common::format_duration(sel.timeout_ns));
+  }
+  return true;
+}
+
+std::string not_started(const Selection& sel) {
+  return fmt::format("the run's time-out ({}) ran out before this script started", common::format_duration(sel.timeout_ns));
+}
+
+// A run's text report: the verdict with its duration on the scan clock, then why it did
+// not pass.
+void print_run(const script::Script& s, const script::ScriptResult& r, const std::vector<std::string>& pous,
+               const script::RunOptions& ro, uint64_t failed_exchanges) {
+  std::string pou_list;
+  for (const auto& p : pous) pou_list += (pou_list.empty() ? "" : ", ") + p;
+  std::cout << fmt::format("\n[{}] {}  ({} s on the scan clock, {} scans; POUs {}; p_lst {} of the latest {})\n", s.path,
+                           title(script::verdict_name(r.verdict)), secs(r.end_ns), r.scans, pou_list.empty() ? "none" : pou_list,
+                           ro.p_lst, ro.mci.psi);
+  bool waited = false;
+  for (const auto& a : r.asserts)
+    if (a.waited) {
+      waited = true;
+      std::cout << fmt::format("  {}: {}: waited {} cycle(s) through a communication error, {}; c = {}, m_ci = {:.3g}\n",
+                               a.where, a.text, a.held ? a.cycles : a.cycles - 1, a.held ? "then it held" : "it never held",
+                               a.cycles, a.mci);
+    }
+  // The waited assertion's line says why the run ended, unless something cut its wait
+  // short (a time-out, an interrupt).
+  const bool said = waited && r.reason.rfind(r.asserts.back().where + ": ", 0) == 0;
+  if (!r.reason.empty() && !said) std::cout << "  " << r.reason << "\n";
+  if (r.verdict == script::Verdict::Undecidable && !r.asserts.empty() && r.asserts.back().has_mci)
+    std::cout << fmt::format("  possible external problem, factor = {:.3g}\n", r.asserts.back().mci);
+  if (failed_exchanges > 0) std::cout << fmt::format("  communication: {} exchange(s) failed\n", failed_exchanges);
+}
+
+// A script in the test model (what --junit reports): a suite of one test, named as
+// --filter and --list name them.
+testing::TestSuite script_suite(const script::Script& s, const std::vector<std::pair<std::string, std::string>>& run_props) {
+  testing::TestSuite suite;
+  suite.name = s.path;
+  suite.properties = run_props;
+  suite.cases.emplace_back();
+  suite.cases.back().name = s.name;
+  return suite;
+}
+
+// Its test after the run: the verdict (undecidable: neither a pass nor a failure of the
+// program), why it did not pass, its duration on the scan clock, m_ci and p_lst.
+testing::TestCase script_case(const script::Script& s, const script::ScriptResult& r, const script::HistoryRow& row,
+                              int64_t p_lst) {
+  testing::TestCase c;
+  c.name = s.name;
+  c.seconds = static_cast<double>(r.end_ns) * 1e-9;
+  c.verdict = r.verdict == script::Verdict::Failed        ? testing::Verdict::Fail
+              : r.verdict == script::Verdict::Undecidable ? testing::Verdict::Undecidable
+                                                          : testing::Verdict::Pass;
+  if (c.verdict != testing::Verdict::Pass) c.findings.push_back({"", r.reason});
+  if (c.verdict == testing::Verdict::Undecidable && row.mci) c.properties.emplace_back("m_ci", fmt::format("{:.3g}", *row.mci));
+  c.properties.emplace_back("verdict", row.verdict);
+  c.properties.emplace_back("p_lst", std::to_string(p_lst));
+  return c;
+}
+
+script::HistoryRow history_row(const script::Script& s, const script::ScriptResult& r, const std::string& prog_hash,
+                               const std::string& pou_hash) {
+  script::HistoryRow row;
+  row.test = s.name;
+  row.verdict = script::verdict_name(r.verdict);
+  row.time = script::utc_now();
+  for (const auto& a : r.asserts)
+    if (a.has_mci) {
+      row.mci = a.mci;
+      row.cycles = a.cycles;
+    }
+  row.program_hash = prog_hash;
+  row.pou_hash = pou_hash;
+  row.reason = r.reason;
+  return row;
+}
+
 }  // namespace
 
 int cmd_script(const std::vector<std::string>& args) {
   const std::string usage =
       "plcfi script PROGRAM.st... TEST.cpt... [--plant stamping|bead_dispenser | --io FILE] [--realtime] [--history FILE] "
-      "[--log DIR] [--junit F] [--link-fault [DEVICE=]AT:FOR] [--max-wait 1s] [--alpha A --beta B --gamma G --psi P --n N]";
+      "[--log DIR] [--junit F] [--filter GLOB] [--list] [--test-timeout D] [--timeout D] [--link-fault [DEVICE=]AT:FOR] "
+      "[--max-wait 1s] [--alpha A --beta B --gamma G --psi P --n N]";
   po::options_description desc(
       "plcfi script: CPTest+ test scripts against a PLC program, on a plant model in virtual time or on bench I/O in real time");
   desc.add_options()
@@ -126,6 +254,10 @@ int cmd_script(const std::vector<std::string>& args) {
       ("history", po::value<std::string>(), "run history (SQLite; default $PLCFI_HISTORY or ~/.local/state/plcfi/history.sqlite)")
       ("log", po::value<std::string>(), "folder for each run's log: TEST.log (text), TEST.csv (snapshots), TEST.vcd (every scan)")
       ("junit", po::value<std::string>(), "write JUnit XML (undecidable: skipped, with m_ci)")
+      ("filter", po::value<std::vector<std::string>>(), "run (or list) only the scripts this shell pattern matches: their path as given, their test name (the file name without .cpt) or PATH/TEST (repeatable)")
+      ("list", "list the scripts (PATH/TEST) the run would run, and run none")
+      ("test-timeout", po::value<std::string>(), "a time-out per script on its scan clock: a script that runs longer fails")
+      ("timeout", po::value<std::string>(), "a time-out of the whole run on the scan clock (all scripts together): the script running when it runs out fails, the later ones fail unrun")
       ("link-fault", po::value<std::string>(), "break a link in every run: [DEVICE=]AT:FOR, e.g. 100ms:300ms (DEVICE: plant offline, the first of the io file on a bench)")
       ("link-status", po::value<std::string>(), "an %IX bit that reads TRUE while the link to the plant works")
       ("max-wait", po::value<std::string>()->default_value("1s"), "how long ASSERT_COM re-checks through a communication error")
@@ -144,6 +276,8 @@ int cmd_script(const std::vector<std::string>& args) {
     std::cerr << "plcfi script: expected the program's ST files and one or more .cpt scripts\nusage: " << usage << "\n";
     return 2;
   }
+  Selection sel;
+  if (!selection_of(vm, &sel)) return 2;
   std::string err;
   script::RunOptions ro;
   ro.mci.alpha = number_option(vm, "alpha");
@@ -265,6 +399,12 @@ int cmd_script(const std::vector<std::string>& args) {
       return 2;
     }
   }
+  const std::vector<size_t> chosen = selected_scripts(parsed, sel.filter);
+  if (sel.list) {  // what would run, without running it
+    for (size_t i : chosen) std::cout << parsed[i].path << "/" << parsed[i].name << "\n";
+    return 0;
+  }
+  if (chosen.empty()) std::cerr << "plcfi script: --filter selects none of the " << scripts.size() << " script(s)\n";
   rt::Runtime runtime(app, sched, backend);
   if (bench) runtime.set_safe_state(cfg.safe_state);
   // Every way out once the devices are open: the safe output state reaches them first.
@@ -300,10 +440,9 @@ int cmd_script(const std::vector<std::string>& args) {
   ro.signals = &signals;
   const std::string prog_hash = script::program_hash(*b);
   const uint64_t seed = vm["seed"].as<Count>().value;
-  report::JunitSuite suite;
-  suite.name = "plcfi script";
-  suite.properties = {{"io", where}, {"history", history_path}};
-  int failed = 0, undecidable = 0, passed = 0;
+  const std::vector<std::pair<std::string, std::string>> run_props = {{"io", where}, {"history", history_path}};
+  std::vector<testing::TestSuite> suites;
+  int64_t used_ns = 0;  // the scan clock of the scripts run so far (--timeout)
   std::cout << fmt::format("plcfi script: {} on {}, history {}\n", programs.front(), where, history_path);
   // Paced on a bench (or offline with --realtime): the real-time loop watches signals and
   // lost devices; a way out it takes ends the run undecidable, with its reason.
@@ -319,8 +458,16 @@ int cmd_script(const std::vector<std::string>& args) {
       return true;
     };
   }
-  for (size_t i = 0; i < bound.size(); ++i) {
+  for (size_t i : chosen) {
     const script::Script& s = parsed[i];
+    suites.push_back(script_suite(s, run_props));
+    if (!limit_time(sel, used_ns, &ro)) {
+      testing::TestCase& c = suites.back().cases.back();
+      c.verdict = testing::Verdict::Fail;
+      c.findings.push_back({"", not_started(sel)});
+      std::cout << fmt::format("\n[{}] Failed  (not run)\n  {}\n", s.path, c.findings.back().text);
+      continue;
+    }
     std::vector<std::string> pous;
     const std::string pou_hash = script::involved_pous_hash(*b, bound[i].var_paths, &pous);
     if (!history->passes_since_change(s.name, pou_hash, ro.mci.psi, &ro.p_lst, &err)) {
@@ -347,6 +494,7 @@ int cmd_script(const std::vector<std::string>& args) {
     }
     const uint64_t failed_before = backend->failed_exchanges();
     script::ScriptResult r = script::run_script(runtime, bound[i], ro);
+    used_ns += r.end_ns;
     if (vcd) {
       runtime.remove_hooks(vcd_hook.get());
       if (!vcd->close(&err)) {
@@ -354,37 +502,8 @@ int cmd_script(const std::vector<std::string>& args) {
         return 2;
       }
     }
-    const uint64_t failed_now = backend->failed_exchanges() - failed_before;
-    std::string pou_list;
-    for (const auto& p : pous) pou_list += (pou_list.empty() ? "" : ", ") + p;
-    std::cout << fmt::format("\n[{}] {}  ({} s on the scan clock, {} scans; POUs {}; p_lst {} of the latest {})\n", s.path,
-                             title(script::verdict_name(r.verdict)), secs(r.end_ns), r.scans, pou_list.empty() ? "none" : pou_list,
-                             ro.p_lst, ro.mci.psi);
-    bool waited = false;
-    for (const auto& a : r.asserts)
-      if (a.waited) {
-        waited = true;
-        std::cout << fmt::format("  {}: {}: waited {} cycle(s) through a communication error, {}; c = {}, m_ci = {:.3g}\n",
-                                 a.where, a.text, a.held ? a.cycles : a.cycles - 1, a.held ? "then it held" : "it never held",
-                                 a.cycles, a.mci);
-      }
-    if (!r.reason.empty() && !waited) std::cout << "  " << r.reason << "\n";
-    if (r.verdict == script::Verdict::Undecidable && !r.asserts.empty() && r.asserts.back().has_mci)
-      std::cout << fmt::format("  possible external problem, factor = {:.3g}\n", r.asserts.back().mci);
-    if (failed_now > 0) std::cout << fmt::format("  communication: {} exchange(s) failed\n", failed_now);
-
-    script::HistoryRow row;
-    row.test = s.name;
-    row.verdict = script::verdict_name(r.verdict);
-    row.time = script::utc_now();
-    for (const auto& a : r.asserts)
-      if (a.has_mci) {
-        row.mci = a.mci;
-        row.cycles = a.cycles;
-      }
-    row.program_hash = prog_hash;
-    row.pou_hash = pou_hash;
-    row.reason = r.reason;
+    print_run(s, r, pous, ro, backend->failed_exchanges() - failed_before);
+    const script::HistoryRow row = history_row(s, r, prog_hash, pou_hash);
     if (!history->add(row, &err)) {
       std::cerr << "plcfi script: " << err << "\n";
       return 2;
@@ -395,34 +514,16 @@ int cmd_script(const std::vector<std::string>& args) {
         return 2;
       }
     }
-    report::JunitCase jc;
-    jc.classname = "script";
-    jc.name = s.name;
-    jc.seconds = static_cast<double>(r.end_ns) * 1e-9;
-    if (r.verdict == script::Verdict::Failed) {
-      jc.outcome = report::JunitCase::Outcome::Fail;
-      jc.message = r.reason;
-      ++failed;
-    } else if (r.verdict == script::Verdict::Undecidable) {
-      // Neither a pass nor a failure of the program.
-      jc.outcome = report::JunitCase::Outcome::Skipped;
-      jc.message = "undecidable: " + r.reason;
-      if (row.mci) jc.properties.emplace_back("m_ci", fmt::format("{:.3g}", *row.mci));
-      ++undecidable;
-    } else {
-      ++passed;
-    }
-    jc.properties.emplace_back("verdict", row.verdict);
-    jc.properties.emplace_back("p_lst", std::to_string(ro.p_lst));
-    suite.cases.push_back(jc);
+    suites.back().cases.back() = script_case(s, r, row, ro.p_lst);
     if (signals.requested()) break;
   }
-  std::cout << fmt::format("\n{} passed, {} failed, {} undecidable\n", passed, failed, undecidable);
-  if (vm.count("junit") && !report::write_junit(vm["junit"].as<std::string>(), {suite}, &err)) {
+  const testing::Totals t = testing::totals(suites);
+  std::cout << fmt::format("\n{} passed, {} failed, {} undecidable\n", t.passed, t.failed, t.undecidable);
+  if (vm.count("junit") && !report::write_test_junit(vm["junit"].as<std::string>(), suites, &err)) {
     std::cerr << "plcfi script: " << err << "\n";
     return 2;
   }
-  return failed > 0 ? 1 : 0;
+  return t.failed > 0 ? 1 : 0;
 }
 
 int cmd_history(const std::vector<std::string>& args) {

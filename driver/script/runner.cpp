@@ -43,6 +43,7 @@ class Run {
         if (!t.programs.empty() && t.programs.front() == 0) interval = t.interval_ns;
     ticks_per_cycle_ = std::max<int64_t>(1, interval / rt.schedule().tick_ns());
     start_scans_ = rt.scan_count();
+    start_ns_ = rt.now();
     errors_mark_ = errors();
   }
 
@@ -80,9 +81,10 @@ class Run {
     note(LogEntry::Kind::Snapshot, line, why, static_cast<int>(res_.snapshots.size() - 1));
   }
 
-  // One scan; false when the run must end (trap, interrupt, a lost device).
+  // One scan; false when the run must end (trap, interrupt, a lost device, the time limit).
   bool scan() {
     if (opt_.signals && opt_.signals->requested()) return end(Verdict::Undecidable, "interrupted (" + opt_.signals->name() + ")");
+    if (opt_.time_limit_ns > 0 && rt_.now() - start_ns_ >= opt_.time_limit_ns) return end(Verdict::Failed, opt_.time_limit_reason);
     std::string why;
     if (opt_.scan) {
       if (!opt_.scan(rt_, &why)) return end(Verdict::Undecidable, why);
@@ -187,6 +189,7 @@ class Run {
   std::vector<st::VarHandle> vars_;
   int64_t ticks_per_cycle_ = 1;
   uint64_t start_scans_ = 0;
+  int64_t start_ns_ = 0;
   uint64_t errors_mark_ = 0;
 };
 

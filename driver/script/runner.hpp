@@ -26,6 +26,10 @@ struct RunOptions {
   // One scan; the default is Runtime::scan() (virtual time). A bench run paces it and
   // watches its devices; returning false ends the run with *why as the reason.
   std::function<bool(rt::Runtime&, std::string* why)> scan;
+  // The scan-clock time the run may take (0: no limit): a run that needs a scan beyond it
+  // ends Failed with time_limit_reason (plcfi script's --test-timeout and --timeout).
+  int64_t time_limit_ns = 0;
+  std::string time_limit_reason;
 };
 
 struct LogEntry {

@@ -27,6 +27,7 @@ grep -q "Undecidable .*p_lst 10 of the latest 10" "$work/run12.txt"
 grep -q "possible external problem, factor = 1$" "$work/run12.txt"
 grep -q '<skipped message="undecidable: ' "$work/junit12.xml"
 grep -q '<property name="m_ci" value="1"/>' "$work/junit12.xml"
+grep -q '<testcase classname="[^"]*/tests/pass_one_ball.cpt" name="pass_one_ball" time="1.500000"' "$work/junit12.xml"
 [ $s13 -eq 1 ] || { echo "run 13: exit $s13, expected 1"; exit 1; }
 grep -q "Failed .*POUs DISPENSER; p_lst 0 of the latest 10" "$work/run13.txt"
 grep -q "IS_BEAD_SEEN is FALSE (no communication error)" "$work/run13.txt"

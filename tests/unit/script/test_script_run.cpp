@@ -144,6 +144,41 @@ TEST(ScriptRun, WaitCountsTaskCyclesAndRoundsTimeUp) {
   EXPECT_EQ(r.end_ns, 1'060'000'000);
 }
 
+TEST(ScriptRun, TimeLimitEndsALongerRunFailed) {
+  RunOptions ro;
+  ro.time_limit_ns = 500'000'000;
+  ro.time_limit_reason = "did not finish within the per-test time-out (500ms)";
+  // 500 ms of waiting needs no scan beyond the limit: it passes.
+  BeadStand s;
+  ScriptResult r = s.run(kPublished, ro);
+  EXPECT_EQ(r.verdict, Verdict::Passed) << r.reason;
+  EXPECT_EQ(r.end_ns, 500'000'000);
+  // 600 ms does: the run ends at the limit, Failed with the reason, the rest not run.
+  BeadStand s2;
+  r = s2.run("WAIT 600 MS\nLOG not reached\n", ro);
+  EXPECT_EQ(r.verdict, Verdict::Failed);
+  EXPECT_EQ(r.reason, "did not finish within the per-test time-out (500ms)");
+  EXPECT_EQ(r.end_ns, 500'000'000);
+  EXPECT_EQ(r.scans, 50u);
+  for (const auto& e : r.log) EXPECT_NE(e.text, "not reached");
+}
+
+TEST(ScriptRun, TimeLimitCutsAnAssertComWaitFailed) {
+  // Without the limit this run is undecidable (see above); the limit ends its wait first.
+  BeadStand s;
+  RunOptions ro;
+  ro.p_lst = 10;
+  ro.max_wait_ns = 200'000'000;
+  ro.time_limit_ns = 600'000'000;
+  ro.time_limit_reason = "out of time";
+  ScriptResult r = s.run(std::string("FAULT LINK plant FOR 2 S\n") + kPublished, ro);
+  EXPECT_EQ(r.verdict, Verdict::Failed);
+  EXPECT_EQ(r.reason, "out of time");
+  EXPECT_EQ(r.end_ns, 600'000'000);
+  ASSERT_EQ(r.asserts.size(), 1u);
+  EXPECT_TRUE(r.asserts[0].waited);
+}
+
 TEST(ScriptRun, PlainAssertFailsWithoutWaitingEvenOnABrokenLink) {
   BeadStand s;
   ScriptResult r = s.run("FAULT LINK plant FOR 1 S\nWAIT 50 MS\nASSERT ISTRUE IS_BEAD_SEEN\nLOG not reached\n");
