@@ -400,11 +400,15 @@ int cmd_script(const std::vector<std::string>& args) {
     }
   }
   const std::vector<size_t> chosen = selected_scripts(parsed, sel.filter);
+  // A --filter that selects nothing is a mistake (a misspelt name), not a green run.
+  if (chosen.empty()) {
+    std::cerr << "plcfi script: --filter selects none of the " << scripts.size() << " script(s): --list shows them (PATH/TEST)\n";
+    return 2;
+  }
   if (sel.list) {  // what would run, without running it
     for (size_t i : chosen) std::cout << parsed[i].path << "/" << parsed[i].name << "\n";
     return 0;
   }
-  if (chosen.empty()) std::cerr << "plcfi script: --filter selects none of the " << scripts.size() << " script(s)\n";
   rt::Runtime runtime(app, sched, backend);
   if (bench) runtime.set_safe_state(cfg.safe_state);
   // Every way out once the devices are open: the safe output state reaches them first.
