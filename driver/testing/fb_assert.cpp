@@ -46,6 +46,10 @@ std::string text_at(const uint8_t* mem, uint32_t addr, uint32_t size) {
 }
 
 
+std::vector<Found> fb_assert_instances(const st::Application& app) {
+  return find_instances(app, [](const st::PouInfo* p) { return p->is_stdlib && st::iequals(p->name, "FB_ASSERT"); });
+}
+
 // A unit's state machine as the scans see it: the state it is in and since when, and how
 // long each state lasted (its last stay).
 struct Unit {
@@ -122,7 +126,7 @@ std::vector<std::string> fb_assert_units(const st::Application& app, st::Machine
     *trap = st::describe_trap(app, m.trap()) + " (in FB_init/FB_exit at the restart)";
     return out;
   }
-  for (const auto& f : find_instances(app, [](const st::PouInfo* p) { return p->is_stdlib && st::iequals(p->name, "FB_ASSERT"); }))
+  for (const auto& f : fb_assert_instances(app))
     if (const st::Field* name = f.type->type->field("_faName")) {
       std::string unit = text_at(m.mem(), f.addr + name->offset, name->type->size);
       if (std::find(out.begin(), out.end(), unit) == out.end()) out.push_back(std::move(unit));
@@ -134,7 +138,7 @@ UntilReport run_until(const st::Application& app, const rt::Schedule& schedule, 
                       const st::ProgramInstance& until, uint32_t reached, const UntilOptions& opt) {
   UntilReport rep;
   UntilScan scan(app, until, reached, opt, &rep);
-  for (const auto& f : find_instances(app, [](const st::PouInfo* p) { return p->is_stdlib && st::iequals(p->name, "FB_ASSERT"); })) {
+  for (const auto& f : fb_assert_instances(app)) {
     const st::Field* step = f.type->type->field("_faStep");
     const st::Field* name = f.type->type->field("_faName");
     if (!step || !name) continue;

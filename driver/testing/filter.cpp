@@ -16,17 +16,6 @@ bool Filter::selects(const std::string& suite, const std::string& test) const {
   return false;
 }
 
-bool Filter::may_select_suite(const std::string& suite) const {
-  if (globs_.empty()) return true;
-  for (const auto& g : globs_) {
-    if (glob(g, suite)) return true;
-    // A glob of SUITE/TEST whose suite part may be this one, or one naming tests only.
-    const auto slash = g.rfind('/');
-    if (slash == std::string::npos || glob(g.substr(0, slash), suite)) return true;
-  }
-  return false;
-}
-
 bool Filter::names_suite(const std::string& suite) const {
   if (globs_.empty()) return true;
   for (const auto& g : globs_) {

@@ -15,8 +15,6 @@ class Filter {
   // A test is selected when there is no glob, or one glob (shell pattern: * ? [...])
   // matches its suite's name, its own name, or "SUITE/TEST".
   bool selects(const std::string& suite, const std::string& test) const;
-  // Some test of this suite may be selected (its name, or a glob naming tests).
-  bool may_select_suite(const std::string& suite) const;
   // A glob names this suite: it matches the suite's name, or its SUITE part does.
   bool names_suite(const std::string& suite) const;
 

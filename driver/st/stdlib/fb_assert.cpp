@@ -9,10 +9,7 @@ namespace plcfi::st {
 
 namespace {
 
-using assert_lib::Elementary;
-using assert_lib::elementary;
-using assert_lib::hex_function;
-using assert_lib::replace_all;
+using namespace assert_lib;
 
 // FB_ASSERT's AreEqual<TYPE> (REAL and LREAL within an optional Delta, exact without).
 std::string are_equal(const Elementary& e, const std::string& name) {

@@ -31,10 +31,7 @@ namespace plcfi::st {
 
 namespace {
 
-using assert_lib::Elementary;
-using assert_lib::elementary;
-using assert_lib::hex_function;
-using assert_lib::replace_all;
+using namespace assert_lib;
 
 // Element types of AssertArrayEquals_<T>.
 // TcUnit has these 1-dimensional ones, and 2- and 3-dimensional ones of REAL and LREAL.
