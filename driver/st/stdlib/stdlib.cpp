@@ -70,6 +70,18 @@ END_FUNCTION_BLOCK
 
 std::string build_stdlib() {
   std::string text = R"ST(
+(* The state of a textual SFC (syntax/sfc_lower.hpp): a step (X active, T time active), an
+   action control (Q its output, A active including the final scan) and the chart's clock. *)
+TYPE
+  __SFC_STEP : STRUCT X : BOOL; T : TIME; END_STRUCT;
+  __SFC_ACTION : STRUCT
+    Q : BOOL; A : BOOL;
+    __r : BOOL; __s : BOOL; __p : BOOL; __pm : BOOL; __p0 : BOOL; __p0m : BOOL;
+    __ff : BOOL; __run : BOOL; __et : TIME; __tq : BOOL; __qprev : BOOL;
+  END_STRUCT;
+  __SFC_CHART : STRUCT started : BOOL; last : TIME; END_STRUCT;
+END_TYPE
+
 (* TON: Q rises when IN has been TRUE for PT; ET counts up to PT and resets with IN. *)
 FUNCTION_BLOCK TON
 VAR_INPUT IN : BOOL; PT : TIME; END_VAR

@@ -362,6 +362,48 @@ struct MockFunctionStmt : Stmt {
   ExprPtr value;
 };
 
+// ---------------------------------------------------------------- SFC
+
+// A textual Sequential Function Chart (IEC 61131-3, the textual form of SFC): what the
+// parser read. The parser lowers it into the POU's variables and statements (see
+// sfc_lower.hpp); what stays here describes the chart (names and locations) for the tools.
+struct SfcAssociation {   // Fill(N), Timer(D, T#5s), Lamp(S, ind)
+  Ident action;
+  std::string qualifier = "N";  // N R S P P1 P0 L D SD DS SL
+  SourceLoc qualifier_loc;
+  ExprPtr time;                 // L, D, SD, DS, SL: the duration; moved out by the lowering
+  std::vector<Ident> indicators;
+  SourceLoc loc;
+};
+
+struct SfcStep {
+  Ident name;
+  bool initial = false;
+  std::vector<SfcAssociation> actions;
+  SourceLoc loc;
+};
+
+struct SfcTransition {
+  std::optional<Ident> name;
+  std::optional<int64_t> priority;  // (PRIORITY := n): lower numbers are tried first
+  std::vector<Ident> from, to;
+  ExprPtr condition;                // moved out by the lowering
+  SourceLoc loc;
+};
+
+struct SfcAction {
+  Ident name;
+  StmtList body;                    // moved out by the lowering
+  SourceLoc loc;
+};
+
+struct SfcChart {
+  std::vector<SfcStep> steps;
+  std::vector<SfcTransition> transitions;
+  std::vector<SfcAction> actions;
+  SourceLoc loc;                    // the first element
+};
+
 // ---------------------------------------------------------------- POUs
 
 
@@ -382,6 +424,8 @@ struct Pou {
   bool is_final = false;
   std::vector<std::unique_ptr<Pou>> methods;      // METHOD ... END_METHOD inside FB/interface
   std::vector<std::unique_ptr<PropertyDecl>> properties;
+  // PROGRAM / FUNCTION_BLOCK written in SFC: the chart (already lowered into body).
+  std::unique_ptr<SfcChart> sfc;
   // Method:
   Access access = Access::Public;
   bool has_body = true;            // interface methods: false

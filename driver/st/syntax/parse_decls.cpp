@@ -1,21 +1,11 @@
 // Declarations: POUs (programs, functions, function blocks, interfaces, methods, properties),
 // VAR blocks, types, and configurations with their resources, tasks and program instances.
 #include "parser_impl.hpp"
+#include "sfc_lower.hpp"
 
 namespace plcfi::st::detail {
 
 namespace {
-
-const char* pou_keyword(PouKind k) {
-  switch (k) {
-    case PouKind::Program: return "PROGRAM";
-    case PouKind::FunctionBlock: return "FUNCTION_BLOCK";
-    case PouKind::Function: return "FUNCTION";
-    case PouKind::Method: return "METHOD";
-    case PouKind::Interface: return "INTERFACE";
-  }
-  return "POU";
-}
 
 TypeSpecPtr error_type(SourceLoc loc) {
   auto t = std::make_unique<TypeSpec>();
@@ -455,9 +445,16 @@ void Parser::parse_pou_body(Pou& pou, bool allow_members) {
     } else if (at(Tok::Eof) || is_unit_end(cur().kind) || is_top_level_start(cur().kind) || at(Tok::Resource) ||
                at_test_block_start()) {
       return;
+    } else if (at_sfc_start()) {
+      parse_sfc_element(pou);
+      seen_statements = true;
     } else {
       const size_t first = pou.body.size();
       parse_stmt_list(pou.body, false);
+      if (pou.body.size() > first && pou.sfc)
+        error("ST141", pou.body[first]->loc, std::string(pou_keyword(pou.kind)) + " '" + pou.name.text +
+                                                 "' mixes SFC elements and ST statements: its body is either a chart "
+                                                 "or a statement list (put the statements into an ACTION)", true);
       if (pou.body.size() > first) {
         seen_statements = true;
         if (pou.kind == PouKind::Interface || !pou.has_body)
@@ -518,6 +515,7 @@ PouPtr Parser::parse_pou() {
   parse_pou_body(*pou, pou->kind != PouKind::Function);
   const std::string what = std::string(pou_keyword(pou->kind)) + " '" + pou->name.text + "'";
   expect_unit_end(end, what, kw.loc, &pou->end_loc);
+  if (pou->sfc) lower_sfc(*pou, diags_);
   return pou;
 }
 

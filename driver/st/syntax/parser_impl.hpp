@@ -69,6 +69,17 @@ inline bool is_strayable(Tok k) {
          k == Tok::EndStruct || k == Tok::EndType || k == Tok::Then || k == Tok::Do || k == Tok::Of;
 }
 
+inline const char* pou_keyword(PouKind k) {
+  switch (k) {
+    case PouKind::Program: return "PROGRAM";
+    case PouKind::FunctionBlock: return "FUNCTION_BLOCK";
+    case PouKind::Function: return "FUNCTION";
+    case PouKind::Method: return "METHOD";
+    case PouKind::Interface: return "INTERFACE";
+  }
+  return "POU";
+}
+
 inline ExprPtr error_expr(SourceLoc loc) {
   auto e = std::make_unique<NameExpr>(loc);
   e->name = Ident{"<error>", loc};
@@ -212,7 +223,7 @@ class Parser {
       case Tok::EndType: case Tok::Method: case Tok::Property: case Tok::Resource:
         return true;
       default:
-        return at_test_block_start();
+        return at_test_block_start() || at_sfc_start() || (in_sfc_action_ && at_word("END_ACTION"));
     }
   }
   bool looks_like_case_label() const {
@@ -301,6 +312,20 @@ class Parser {
   void parse_resource_body(ResourceDecl& res, Tok end);
   TaskDecl parse_task();
   ProgramInstDecl parse_program_inst();
+
+  // ------------------------------------------------------------ SFC (parse_sfc.cpp)
+  // The start of a textual SFC element: INITIAL_STEP/STEP name ':', ACTION name ':' or
+  // TRANSITION [name] [(PRIORITY := n)] FROM. These words are not reserved in ST, so a
+  // variable called `step` or `action` still parses as one.
+  bool at_sfc_start() const;
+  void parse_sfc_element(Pou& pou);
+  void parse_sfc_step(SfcChart& chart);
+  void parse_sfc_association(SfcStep& step);
+  void parse_sfc_transition(SfcChart& chart);
+  bool parse_sfc_step_list(std::vector<Ident>& out, const char* what);
+  void parse_sfc_action(SfcChart& chart);
+  void expect_sfc_end(std::string_view end, const std::string& what, SourceLoc open_loc);
+  bool in_sfc_action_ = false;
 
   // ------------------------------------------------------------ test files (parse_tests.cpp)
   StmtPtr parse_mock();

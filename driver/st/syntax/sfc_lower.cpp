@@ -1,0 +1,387 @@
+// Textual SFC to ST; the rules are in sfc_lower.hpp.
+#include "sfc_lower.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <map>
+#include <set>
+
+namespace plcfi::st {
+
+namespace {
+
+// AST builders, every node at one location (the SFC element it comes from).
+struct At {
+  SourceLoc l;
+
+  ExprPtr name(const std::string& n) const {
+    auto e = std::make_unique<NameExpr>(l);
+    e->name = Ident{n, l};
+    return e;
+  }
+  ExprPtr field(const std::string& var, const std::string& f) const {
+    auto e = std::make_unique<MemberExpr>(l);
+    e->base = name(var);
+    e->member = Ident{f, l};
+    return e;
+  }
+  ExprPtr bin(BinaryOp op, ExprPtr a, ExprPtr b) const {
+    auto e = std::make_unique<BinaryExpr>(l);
+    e->op = op;
+    e->lhs = std::move(a);
+    e->rhs = std::move(b);
+    return e;
+  }
+  ExprPtr and_(ExprPtr a, ExprPtr b) const { return bin(BinaryOp::And, std::move(a), std::move(b)); }
+  ExprPtr or_(ExprPtr a, ExprPtr b) const { return bin(BinaryOp::Or, std::move(a), std::move(b)); }
+  ExprPtr not_(ExprPtr a) const {
+    auto e = std::make_unique<UnaryExpr>(l);
+    e->op = UnaryOp::Not;
+    e->operand = std::move(a);
+    return e;
+  }
+  ExprPtr boolean(bool v) const {
+    auto e = std::make_unique<LiteralExpr>(l);
+    e->lit = LiteralKind::Bool;
+    e->int_value = v ? 1 : 0;
+    return e;
+  }
+  ExprPtr zero_time() const {
+    auto e = std::make_unique<LiteralExpr>(l);
+    e->lit = LiteralKind::Time;
+    e->type_prefix = "T";
+    return e;
+  }
+  ExprPtr now() const {
+    auto e = std::make_unique<CallExpr>(l);
+    e->callee = name("__NOW");
+    return e;
+  }
+  StmtPtr assign(ExprPtr lhs, ExprPtr rhs) const {
+    auto s = std::make_unique<AssignStmt>(l);
+    s->lhs = std::move(lhs);
+    s->rhs = std::move(rhs);
+    return s;
+  }
+  StmtPtr when(ExprPtr cond, StmtList then, std::optional<StmtList> otherwise = std::nullopt) const {
+    auto s = std::make_unique<IfStmt>(l);
+    IfStmt::Arm arm;
+    arm.cond = std::move(cond);
+    arm.body = std::move(then);
+    arm.loc = l;
+    s->arms.push_back(std::move(arm));
+    if (otherwise) {
+      s->else_body = std::move(otherwise);
+      s->else_loc = l;
+    }
+    return s;
+  }
+  VarDecl decl(const std::string& n, const std::string& type, VarSection section, ExprPtr init = nullptr) const {
+    VarDecl d;
+    d.names.push_back(Ident{n, l});
+    d.type = std::make_unique<TypeSpec>();
+    d.type->kind = TypeSpecKind::Named;
+    d.type->name = Ident{type, l};
+    d.type->loc = l;
+    d.init = std::move(init);
+    d.section = section;
+    d.loc = l;
+    return d;
+  }
+};
+
+StmtList one(StmtPtr s) {
+  StmtList list;
+  list.push_back(std::move(s));
+  return list;
+}
+
+// OR of the activity flags of `steps` (at least one).
+ExprPtr any_active(const At& at, const std::vector<std::string>& steps) {
+  ExprPtr e = at.field(steps.front(), "X");
+  for (size_t i = 1; i < steps.size(); ++i) e = at.or_(std::move(e), at.field(steps[i], "X"));
+  return e;
+}
+
+constexpr const char* kChart = "__SFC";
+constexpr const char* kDt = "__sfc_dt";
+
+// One action and what the steps associate with it.
+struct ActionUse {
+  std::string var;            // the __SFC_ACTION variable
+  std::string bool_var;       // a Boolean action: the variable it drives ("" for an ACTION)
+  SourceLoc loc;              // the ACTION, or the first association of a Boolean action
+  std::map<std::string, std::vector<std::string>> steps;  // qualifier -> steps (untimed)
+  SfcAssociation* timed = nullptr;
+  std::string timed_step;
+};
+
+class Lowering {
+ public:
+  Lowering(Pou& pou, DiagEngine& diags) : pou_(pou), chart_(*pou.sfc), diags_(diags) {}
+
+  void run() {
+    if (!check_steps() || !collect_actions() || !check_transitions()) return;
+    const At at{chart_.loc};
+    VarBlock vars, temps;
+    vars.loc = temps.loc = chart_.loc;
+    temps.section = VarSection::Temp;
+    for (const SfcStep& s : chart_.steps) {
+      ExprPtr init;
+      if (s.initial) {
+        auto si = std::make_unique<StructInitExpr>(s.loc);
+        si->items.push_back({Ident{"X", s.loc}, At{s.loc}.boolean(true)});
+        init = std::move(si);
+      }
+      vars.decls.push_back(At{s.name.loc}.decl(s.name.text, "__SFC_STEP", VarSection::Var, std::move(init)));
+    }
+    for (const ActionUse& a : actions_) vars.decls.push_back(At{a.loc}.decl(a.var, "__SFC_ACTION", VarSection::Var));
+    vars.decls.push_back(at.decl(kChart, "__SFC_CHART", VarSection::Var));
+    temps.decls.push_back(at.decl(kDt, "TIME", VarSection::Temp));
+    for (size_t i = 0; i < chart_.transitions.size(); ++i)
+      temps.decls.push_back(At{chart_.transitions[i].loc}.decl(fired(i), "BOOL", VarSection::Temp));
+    pou_.var_blocks.push_back(std::move(vars));
+    pou_.var_blocks.push_back(std::move(temps));
+
+    StmtList& body = pou_.body;
+    body.push_back(at.assign(at.name(kDt), at.zero_time()));
+    StmtList evolve;
+    evolve.push_back(at.assign(at.name(kDt), at.bin(BinaryOp::Sub, at.now(), at.field(kChart, "last"))));
+    for (const SfcStep& s : chart_.steps) {
+      const At st{s.loc};
+      evolve.push_back(st.when(st.field(s.name.text, "X"),
+                               one(st.assign(st.field(s.name.text, "T"),
+                                             st.bin(BinaryOp::Add, st.field(s.name.text, "T"), st.name(kDt))))));
+    }
+    lower_transitions(evolve);
+    body.push_back(at.when(at.field(kChart, "started"), std::move(evolve)));
+    body.push_back(at.assign(at.field(kChart, "started"), at.boolean(true)));
+    body.push_back(at.assign(at.field(kChart, "last"), at.now()));
+    for (const ActionUse& a : actions_) lower_control(a, body);
+    for (const ActionUse& a : actions_) {
+      if (a.bool_var.empty()) continue;
+      const At aa{a.loc};
+      auto s = std::make_unique<IfStmt>(a.loc);
+      IfStmt::Arm on{aa.field(a.var, "Q"), one(aa.assign(aa.name(a.bool_var), aa.boolean(true))), a.loc};
+      IfStmt::Arm final_scan{aa.field(a.var, "A"), one(aa.assign(aa.name(a.bool_var), aa.boolean(false))), a.loc};
+      s->arms.push_back(std::move(on));
+      s->arms.push_back(std::move(final_scan));
+      body.push_back(std::move(s));
+    }
+    for (SfcAction& act : chart_.actions) {
+      const At aa{act.loc};
+      body.push_back(aa.when(aa.field(act.name.text, "A"), std::move(act.body)));
+    }
+  }
+
+ private:
+  static std::string fired(size_t i) { return "__sfc_t" + std::to_string(i); }
+
+  // A step or ACTION is a variable of the POU: its name cannot be one of the POU's own.
+  bool clashes(const Ident& name, const char* kind) {
+    for (const VarBlock& b : pou_.var_blocks)
+      for (const VarDecl& d : b.decls)
+        for (const Ident& n : d.names)
+          if (iequals(n.text, name.text)) {
+            Diagnostic& e = diags_.error("ST141", name.loc, std::string(kind) + " '" + name.text +
+                                                                "' has the name of a variable of " + what() +
+                                                                " (names are case-insensitive)");
+            e.notes.emplace_back(n.loc, "the variable is declared here");
+            return true;
+          }
+    return false;
+  }
+
+  bool check_steps() {
+    bool ok = true, initial = false;
+    for (const SfcStep& s : chart_.steps) {
+      initial |= s.initial;
+      if (clashes(s.name, "step")) ok = false;
+      if (!steps_.emplace(canon(s.name.text), &s).second) {
+        diags_.error("ST141", s.name.loc, "step '" + s.name.text + "' is declared twice in " + what());
+        ok = false;
+      }
+    }
+    if (!initial) {
+      diags_.error("ST141", chart_.loc, what() + " has no INITIAL_STEP: the chart needs one to start from");
+      ok = false;
+    }
+    return ok;
+  }
+
+  bool check_transitions() {
+    bool ok = true;
+    for (const SfcTransition& t : chart_.transitions) {
+      for (const auto* list : {&t.from, &t.to})
+        for (const Ident& s : *list)
+          if (!steps_.count(canon(s.text))) {
+            diags_.error("ST141", s.loc, "transition " + std::string(list == &t.from ? "from" : "to") +
+                                             " an unknown step '" + s.text + "' in " + what());
+            ok = false;
+          }
+      if (!t.condition) ok = false;  // reported by the parser
+    }
+    return ok;
+  }
+
+  // The ACTIONs in declaration order, then the Boolean actions in order of first use.
+  bool collect_actions() {
+    bool ok = true;
+    std::map<std::string, size_t> index;
+    for (const SfcAction& a : chart_.actions) {
+      const std::string key = canon(a.name.text);
+      if (steps_.count(key)) {
+        diags_.error("ST141", a.name.loc, "action '" + a.name.text + "' has the name of a step of " + what());
+        ok = false;
+      } else if (clashes(a.name, "action")) {
+        ok = false;
+      } else if (!index.emplace(key, actions_.size()).second) {
+        diags_.error("ST141", a.name.loc, "action '" + a.name.text + "' is declared twice in " + what());
+        ok = false;
+        continue;
+      }
+      actions_.push_back(ActionUse{a.name.text, "", a.loc, {}, nullptr, ""});
+    }
+    for (SfcStep& s : chart_.steps) {
+      for (SfcAssociation& as : s.actions) {
+        const std::string key = canon(as.action.text);
+        auto it = index.find(key);
+        if (it == index.end()) {
+          it = index.emplace(key, actions_.size()).first;
+          actions_.push_back(ActionUse{"__sfc_" + as.action.text, as.action.text, as.loc, {}, nullptr, ""});
+        }
+        ActionUse& use = actions_[it->second];
+        const bool timed = as.qualifier == "L" || as.qualifier == "D" || as.qualifier == "SD" ||
+                           as.qualifier == "DS" || as.qualifier == "SL";
+        if (!timed) {
+          use.steps[as.qualifier == "P1" ? "P" : as.qualifier].push_back(s.name.text);
+          continue;
+        }
+        if (!as.time) {
+          ok = false;  // reported by the parser
+        } else if (use.timed) {
+          Diagnostic& d = diags_.error(
+              "ST142", as.qualifier_loc,
+              "action '" + as.action.text + "' has a second timed association (" + as.qualifier + " in step '" +
+                  s.name.text + "'): an action control has one timer, so an action takes one of L, D, SD, DS "
+                                "and SL; give each a separate action");
+          d.notes.emplace_back(use.timed->qualifier_loc, "the first timed association");
+          ok = false;
+        } else {
+          use.timed = &as;
+          use.timed_step = s.name.text;
+        }
+      }
+    }
+    return ok;
+  }
+
+  // Transitions in priority order; see sfc_lower.hpp.
+  void lower_transitions(StmtList& out) {
+    std::vector<size_t> order(chart_.transitions.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    const auto key = [&](size_t i) { return chart_.transitions[i].priority.value_or(INT64_MAX); };
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
+    for (size_t i : order) {
+      SfcTransition& t = chart_.transitions[i];
+      const At at{t.loc};
+      ExprPtr enabled;
+      StmtList fire;
+      fire.push_back(at.assign(at.name(fired(i)), at.boolean(true)));
+      for (const Ident& s : t.from) {
+        ExprPtr x = at.field(s.text, "X");
+        enabled = enabled ? at.and_(std::move(enabled), std::move(x)) : std::move(x);
+        fire.push_back(at.assign(at.field(s.text, "X"), at.boolean(false)));
+      }
+      out.push_back(at.assign(at.name(fired(i)), at.boolean(false)));
+      out.push_back(at.when(std::move(enabled), one(at.when(std::move(t.condition), std::move(fire)))));
+    }
+    for (size_t i = 0; i < chart_.transitions.size(); ++i) {
+      const SfcTransition& t = chart_.transitions[i];
+      const At at{t.loc};
+      StmtList enter;
+      for (const Ident& s : t.to) {
+        enter.push_back(at.assign(at.field(s.text, "X"), at.boolean(true)));
+        enter.push_back(at.assign(at.field(s.text, "T"), at.zero_time()));
+      }
+      out.push_back(at.when(at.name(fired(i)), std::move(enter)));
+    }
+  }
+
+  // The action control block of one action (IEC 61131-3), from the active steps.
+  void lower_control(const ActionUse& a, StmtList& out) {
+    const At at{a.loc};
+    const auto f = [&](const char* name) { return at.field(a.var, name); };
+    const auto steps = [&](const char* q) -> const std::vector<std::string>* {
+      auto it = a.steps.find(q);
+      return it == a.steps.end() ? nullptr : &it->second;
+    };
+    const bool has_r = steps("R") != nullptr;
+    out.push_back(at.assign(f("__r"), has_r ? any_active(at, *steps("R")) : at.boolean(false)));
+    ExprPtr q = steps("N") ? any_active(at, *steps("N")) : at.boolean(false);
+    if (const auto* s = steps("S")) {  // S_FF: RS with the reset dominant
+      out.push_back(at.assign(f("__s"), at.and_(at.not_(f("__r")), at.or_(f("__s"), any_active(at, *s)))));
+      q = at.or_(std::move(q), f("__s"));
+    }
+    if (const auto* p = steps("P")) {  // P_TRIG: the rising edge of the association
+      out.push_back(at.assign(f("__p"), at.and_(any_active(at, *p), at.not_(f("__pm")))));
+      out.push_back(at.assign(f("__pm"), any_active(at, *p)));
+      q = at.or_(std::move(q), f("__p"));
+    }
+    if (const auto* p = steps("P0")) {  // the falling edge
+      out.push_back(at.assign(f("__p0"), at.and_(at.not_(any_active(at, *p)), f("__p0m"))));
+      out.push_back(at.assign(f("__p0m"), any_active(at, *p)));
+      q = at.or_(std::move(q), f("__p0"));
+    }
+    if (a.timed) q = at.or_(std::move(q), lower_timed(a, out));
+    out.push_back(at.assign(f("Q"), at.and_(at.not_(f("__r")), std::move(q))));
+    out.push_back(at.assign(f("A"), at.or_(f("Q"), f("__qprev"))));
+    out.push_back(at.assign(f("__qprev"), f("Q")));
+  }
+
+  // The timer of an L, D, SD, DS or SL association (a TON counted in the chart's clock)
+  // and its flip-flop; returns the association's share of Q.
+  ExprPtr lower_timed(const ActionUse& a, StmtList& out) {
+    SfcAssociation& as = *a.timed;
+    const At at{as.loc};
+    const auto f = [&](const char* name) { return at.field(a.var, name); };
+    const std::string& q = as.qualifier;
+    const auto flip_flop = [&](ExprPtr set) {  // RS, reset dominant
+      out.push_back(at.assign(f("__ff"), at.and_(at.not_(f("__r")), at.or_(f("__ff"), std::move(set)))));
+    };
+    // The timer's input.
+    if (q == "SD" || q == "SL") flip_flop(at.field(a.timed_step, "X"));
+    const auto timer_in = [&]() { return q == "SD" || q == "SL" ? f("__ff") : at.field(a.timed_step, "X"); };
+    StmtList running;
+    running.push_back(at.when(f("__run"), one(at.assign(f("__et"), at.bin(BinaryOp::Add, f("__et"), at.name(kDt))))));
+    out.push_back(at.when(timer_in(), std::move(running), one(at.assign(f("__et"), at.zero_time()))));
+    out.push_back(at.assign(f("__run"), timer_in()));
+    out.push_back(at.assign(f("__tq"), at.and_(timer_in(), at.bin(BinaryOp::Ge, f("__et"), std::move(as.time)))));
+    if (q == "L") return at.and_(at.field(a.timed_step, "X"), at.not_(f("__tq")));
+    if (q == "D" || q == "SD") return f("__tq");
+    if (q == "DS") {
+      flip_flop(f("__tq"));
+      return f("__ff");
+    }
+    return at.and_(f("__ff"), at.not_(f("__tq")));  // SL
+  }
+
+  std::string what() const {
+    return std::string(pou_.kind == PouKind::FunctionBlock ? "FUNCTION_BLOCK" : "PROGRAM") + " '" + pou_.name.text + "'";
+  }
+
+  Pou& pou_;
+  SfcChart& chart_;
+  DiagEngine& diags_;
+  std::map<std::string, const SfcStep*> steps_;
+  std::vector<ActionUse> actions_;
+};
+
+}  // namespace
+
+void lower_sfc(Pou& pou, DiagEngine& diags) {
+  if (!pou.sfc || (pou.kind != PouKind::Program && pou.kind != PouKind::FunctionBlock)) return;
+  Lowering(pou, diags).run();
+}
+
+}  // namespace plcfi::st
