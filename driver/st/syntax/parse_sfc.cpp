@@ -117,9 +117,10 @@ void Parser::parse_sfc_association(SfcStep& step) {
         a.time = parse_expr();
       }
     }
-  } else if (at(Tok::Ident) && la(1).kind != Tok::Comma && la(1).kind != Tok::RParen) {
+  } else if (at(Tok::Ident)) {
     error("ST142", cur().loc, describe(cur()) + " is not an action qualifier (N, R, S, P, P1, P0, L, D, SD, DS, SL)");
-  } else if (!at(Tok::RParen) && !at(Tok::Ident)) {
+    advance();
+  } else if (!at(Tok::RParen)) {
     error("ST142", cur().loc, "expected an action qualifier (N, R, S, P, P1, P0, L, D, SD, DS, SL), found " +
                                   describe(cur()));
   }

@@ -121,7 +121,10 @@ class Lowering {
   Lowering(Pou& pou, DiagEngine& diags) : pou_(pou), chart_(*pou.sfc), diags_(diags) {}
 
   void run() {
-    if (!check_steps() || !collect_actions() || !check_transitions()) return;
+    bool ok = check_steps();
+    ok = collect_actions() && ok;
+    ok = check_transitions() && ok;
+    if (!ok) return;
     const At at{chart_.loc};
     VarBlock vars, temps;
     vars.loc = temps.loc = chart_.loc;
