@@ -20,6 +20,7 @@
 
 #include "import/import.hpp"
 #include "import/ld.hpp"
+#include "import/sfc.hpp"
 #include "import/xml_nodes.hpp"
 
 namespace plcfi::st {
@@ -697,9 +698,26 @@ class Importer {
         else if (dn.ends_with("/action") && (is(item, "Action") || is(item, "action"))) action(item, what);
       }
     }
-    for (auto a : children(child(p, "actions"), "action")) action(a, what);
+    // An SFC body becomes textual SFC (import/sfc.hpp); the POU's <actions> and
+    // <transitions> are the chart's and go into it.
+    pugi::xml_node sfc_body = child(child(p, "body"), "SFC");
+    if (!sfc_body)
+      for (auto a : children(child(p, "actions"), "action")) action(a, what);
     if (ld_body) {
       for (const auto& st : ld.body) line(st.text, st.at);
+    } else if (sfc_body) {
+      std::vector<SfcPiece> chart;
+      SfcError err;
+      if (!sfc_to_text(sfc_body, p, what, &chart, &err)) return error(err.code.c_str(), err.at, err.message);
+      for (const SfcPiece& piece : chart) {
+        if (!piece.copy) {
+          line(piece.text, piece.at);
+          continue;
+        }
+        Copy c;
+        gather_text(piece.copy, &c, 0);
+        copy(piece.text, c, piece.suffix);
+      }
     } else {
       body(p, what);
     }
