@@ -35,6 +35,7 @@ struct Input {
   std::string formal;
   bool negated = false;
   std::vector<Conn> from;
+  std::string edge;  // a block input's edge attribute: rising, falling or none
 };
 
 struct Element {
@@ -42,13 +43,14 @@ struct Element {
   std::string kind;
   long id = 0;
   size_t order = 0;  // document order
+  long exec_order = 0;  // executionOrderId (FBD), 0 when not given
   std::vector<Input> inputs;
 };
 
 class Translator {
  public:
-  Translator(const std::string& what, bool instances, LdTranslation* out, LdError* err)
-      : what_(what), instances_(instances), out_(out), err_(err) {}
+  Translator(const std::string& what, bool fbd, bool instances, LdTranslation* out, LdError* err)
+      : what_(what), fbd_(fbd), instances_(instances), out_(out), err_(err) {}
 
   bool run(const pugi::xml_node& ld) {
     if (!collect(ld)) return false;
@@ -56,14 +58,16 @@ class Translator {
     if (!sort(&order)) return false;
     for (const Element* e : order)
       if (!emit(*e)) return false;
-    if (!temps_.empty()) {
+    if (!temps_.empty() || !enos_.empty()) {
       out_->vars.push_back({"VAR_TEMP", ld});
       for (long id : temps_) out_->vars.push_back({"  _ld" + std::to_string(id) + " : BOOL;", ld});
+      for (long id : enos_) out_->vars.push_back({"  _ldeno" + std::to_string(id) + " : BOOL;", ld});
       out_->vars.push_back({"END_VAR", ld});
     }
-    if (!edges_.empty()) {
+    if (!edges_.empty() || !edge_inputs_.empty()) {
       out_->vars.push_back({"VAR", ld});
       for (const auto& [id, type] : edges_) out_->vars.push_back({"  _lde" + std::to_string(id) + " : " + type + ";", ld});
+      for (const auto& [name, type] : edge_inputs_) out_->vars.push_back({"  " + name + " : " + type + ";", ld});
       out_->vars.push_back({"END_VAR", ld});
     }
     return true;
@@ -88,16 +92,21 @@ class Translator {
       if (n.type() != pugi::node_element) continue;
       const std::string kind(local_name(n));
       if (kind == "comment" || kind == "addData" || kind == "documentation") continue;
-      static const std::set<std::string> kKnown = {"leftPowerRail", "rightPowerRail", "contact", "coil", "block",
-                                                  "inVariable", "outVariable", "inOutVariable", "connector",
-                                                  "continuation"};
-      if (!kKnown.count(kind))
-        return fail(n, "the LD element <" + kind + "> is not supported (plcfi translates power rails, contacts, coils, "
-                       "blocks, variables, connectors and continuations)");
+      static const std::set<std::string> kLd = {"leftPowerRail", "rightPowerRail", "contact", "coil", "block",
+                                               "inVariable", "outVariable", "inOutVariable", "connector",
+                                               "continuation"};
+      static const std::set<std::string> kFbd = {"block", "inVariable", "outVariable", "inOutVariable", "connector",
+                                                "continuation"};
+      if (!(fbd_ ? kFbd : kLd).count(kind))
+        return fail(n, fbd_ ? "the FBD element <" + kind + "> is not supported (plcfi translates blocks, variables, "
+                              "connectors and continuations)"
+                            : "the LD element <" + kind + "> is not supported (plcfi translates power rails, contacts, "
+                              "coils, blocks, variables, connectors and continuations)");
       Element e;
       e.n = n;
       e.kind = kind;
       e.order = order++;
+      e.exec_order = std::strtol(n.attribute("executionOrderId").value(), nullptr, 10);
       const char* id = n.attribute("localId").value();
       char* end = nullptr;
       e.id = std::strtol(id, &end, 10);
@@ -106,12 +115,12 @@ class Translator {
         for (auto v : child(n, "inputVariables").children())
           if (is(v, "variable"))
             e.inputs.push_back(Input{v.attribute("formalParameter").value(), v.attribute("negated").as_bool(),
-                                     connections(child(v, "connectionPointIn"))});
+                                     connections(child(v, "connectionPointIn")), v.attribute("edge").value()});
         for (auto v : child(n, "inOutVariables").children())
           if (is(v, "variable"))
-            e.inputs.push_back(Input{v.attribute("formalParameter").value(), false, connections(child(v, "connectionPointIn"))});
+            e.inputs.push_back(Input{v.attribute("formalParameter").value(), false, connections(child(v, "connectionPointIn")), ""});
       } else if (pugi::xml_node in = child(n, "connectionPointIn")) {
-        e.inputs.push_back(Input{"", false, connections(in)});
+        e.inputs.push_back(Input{"", false, connections(in), ""});
       }
       if (kind == "connector") connectors_[trimmed(n.attribute("name").value())] = e.id;
       if (!by_id_.emplace(e.id, elements_.size()).second) return fail(n, "localId " + std::to_string(e.id) + " is used twice");
@@ -132,35 +141,97 @@ class Translator {
     return out;
   }
 
-  // Connections first, document order among the ready ones (Kahn).
+  // Whether element i only gives a value (written where it is used) rather than doing
+  // something in the evaluation order.
+  bool is_statement(const Element& e) const {
+    if (e.kind == "block") return !trimmed(e.n.attribute("instanceName").value()).empty();
+    return e.kind == "outVariable" || e.kind == "inOutVariable" || e.kind == "contact" || e.kind == "coil";
+  }
+
+  // A connection that may close a loop: it reads a variable (an in-out variable) or a
+  // function block instance's output, so it gives the value of the previous evaluation
+  // (the standard's feedback path) and need not come first.
+  bool is_feedback_source(const Element& e) const {
+    return e.kind == "inOutVariable" || (e.kind == "block" && !trimmed(e.n.attribute("instanceName").value()).empty());
+  }
+
+  // The evaluation order. FBD with an executionOrderId on every element that does something
+  // (a function block call, an output or in-out variable): that order; an input wired from
+  // a block evaluated later reads that block's output of the previous evaluation. Otherwise
+  // data flow: an element after the ones it reads, document order among the ready ones
+  // (Kahn). A loop through an in-out variable or a function block's output is a feedback
+  // path (that connection reads the previous value and does not order); any other loop is
+  // an error.
   bool sort(std::vector<const Element*>* out) {
-    std::vector<size_t> missing(elements_.size(), 0);
-    std::vector<std::vector<size_t>> users(elements_.size());
-    for (size_t i = 0; i < elements_.size(); ++i)
+    const size_t n = elements_.size();
+    std::vector<std::vector<size_t>> deps(n);
+    for (size_t i = 0; i < n; ++i)
       for (long ref : depends(elements_[i])) {
         auto it = by_id_.find(ref);
         if (it == by_id_.end())
           return fail(elements_[i].n, "<" + elements_[i].kind + " localId=\"" + std::to_string(elements_[i].id) +
                                           "\"> is connected to localId " + std::to_string(ref) + ", which is not in the network");
-        ++missing[i];
-        users[it->second].push_back(i);
+        deps[i].push_back(it->second);
       }
+    if (fbd_) {
+      bool all = true, any = false;
+      for (const Element& e : elements_) {
+        if (!is_statement(e)) continue;
+        if (e.exec_order > 0) any = true;
+        else all = false;
+      }
+      if (any && all) {
+        for (const Element& e : elements_) out->push_back(&e);
+        std::stable_sort(out->begin(), out->end(), [&](const Element* a, const Element* b) {
+          const long ka = is_statement(*a) ? a->exec_order : 0, kb = is_statement(*b) ? b->exec_order : 0;
+          return ka < kb;
+        });
+        return true;
+      }
+    }
+    std::vector<size_t> missing(n, 0);
+    std::vector<std::vector<size_t>> users(n);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t d : deps[i]) {
+        ++missing[i];
+        users[d].push_back(i);
+      }
+    std::vector<bool> done(n, false);
     std::priority_queue<size_t, std::vector<size_t>, std::greater<>> ready;
-    for (size_t i = 0; i < elements_.size(); ++i)
+    for (size_t i = 0; i < n; ++i)
       if (!missing[i]) ready.push(i);
-    while (!ready.empty()) {
-      size_t i = ready.top();
-      ready.pop();
-      out->push_back(&elements_[i]);
-      for (size_t u : users[i])
-        if (--missing[u] == 0) ready.push(u);
+    for (;;) {
+      while (!ready.empty()) {
+        size_t i = ready.top();
+        ready.pop();
+        done[i] = true;
+        out->push_back(&elements_[i]);
+        for (size_t u : users[i])
+          if (!done[u] && missing[u] > 0 && --missing[u] == 0) ready.push(u);
+      }
+      if (out->size() == n) return true;
+      // Stuck on a loop: cut one feedback connection (the first in document order).
+      bool cut = false;
+      for (size_t i = 0; i < n && !cut; ++i) {
+        if (done[i]) continue;
+        for (size_t d : deps[i]) {
+          if (done[d] || !is_feedback_source(elements_[d])) continue;
+          auto& us = users[d];
+          us.erase(std::find(us.begin(), us.end(), i));
+          if (--missing[i] == 0) ready.push(i);
+          cut = true;
+          break;
+        }
+      }
+      if (!cut) {
+        for (size_t i = 0; i < n; ++i)
+          if (!done[i])
+            return fail(elements_[i].n, "the network has a loop through this <" + elements_[i].kind + "> (localId " +
+                                            std::to_string(elements_[i].id) +
+                                            ") that passes no in-out variable or function block output (a feedback "
+                                            "path needs one to hold the previous value)");
+      }
     }
-    if (out->size() < elements_.size()) {
-      for (size_t i = 0; i < elements_.size(); ++i)
-        if (missing[i]) return fail(elements_[i].n, "the network has a loop through this <" + elements_[i].kind + "> (localId " +
-                                                       std::to_string(elements_[i].id) + ")");
-    }
-    return true;
   }
 
   // The value an element gives at its output `formal` (a block's pin; empty otherwise).
@@ -168,7 +239,8 @@ class Translator {
     const Element& e = elements_[by_id_.at(id)];
     if (e.kind == "leftPowerRail") *v = "TRUE";
     else if (e.kind == "contact" || e.kind == "coil") *v = "_ld" + std::to_string(id);
-    else if (e.kind == "inVariable" || e.kind == "inOutVariable") *v = "(" + expression(e) + ")";
+    else if (e.kind == "inVariable" || e.kind == "inOutVariable")
+      *v = std::string(e.n.attribute("negated").as_bool() ? "NOT " : "") + "(" + expression(e) + ")";
     else if (e.kind == "continuation") {
       auto named = connectors_.find(trimmed(e.n.attribute("name").value()));
       if (named == connectors_.end())
@@ -179,15 +251,84 @@ class Translator {
       --depth_;
       return ok;
     } else if (e.kind == "block") {
-      auto it = block_out_.find(id);
-      if (it == block_out_.end()) return fail(user, "is connected to a block that gives no value");
-      auto pin = it->second.find(formal);
-      if (pin == it->second.end()) pin = it->second.find("");
-      if (pin == it->second.end()) return fail(user, "is connected to output '" + formal + "' of a block that has no such output");
-      *v = pin->second;
+      return block_value(e, formal, user, v);
     } else {
       return fail(user, "is connected to a <" + e.kind + ">, which gives no value");
     }
+    return true;
+  }
+
+  static std::string inst_of(const Element& e) { return trimmed(e.n.attribute("instanceName").value()); }
+  static std::string type_of(const Element& e) { return trimmed(e.n.attribute("typeName").value()); }
+
+  // Whether output `formal` of block e is drawn negated.
+  static bool output_negated(const Element& e, const std::string& formal) {
+    for (auto v : child(e.n, "outputVariables").children())
+      if (is(v, "variable") && formal == v.attribute("formalParameter").value()) return v.attribute("negated").as_bool();
+    return false;
+  }
+
+  // A block's EN input, if it is connected to something other than the left rail.
+  bool enable(const Element& e, std::string* en) {
+    for (const auto& in : e.inputs)
+      if (in.formal == "EN" && !in.from.empty()) {
+        if (!input(e, in, en)) return false;
+        if (*en == "TRUE") en->clear();
+        return true;
+      }
+    en->clear();
+    return true;
+  }
+
+  // The arguments of a block's call (EN apart), `formal := value` for an instance (or
+  // when `named`), in the order of its inputs.
+  bool arguments(const Element& e, bool named, std::string* args) {
+    args->clear();
+    size_t k = 0;
+    for (const auto& in : e.inputs) {
+      ++k;
+      if (in.formal == "EN" || in.from.empty()) continue;
+      std::string v;
+      if (!input(e, in, &v)) return false;
+      if (!in.edge.empty() && in.edge != "none") {
+        if (!instances_) return fail(e.n, "an edge on input '" + in.formal + "' needs an R_TRIG/F_TRIG instance, which a FUNCTION cannot hold");
+        const std::string trig = "_lde" + std::to_string(e.id) + "_" + std::to_string(k);
+        edge_inputs_.emplace_back(trig, in.edge == "falling" ? "F_TRIG" : "R_TRIG");
+        pending_.push_back(trig + "(CLK := " + v + ");");
+        v = trig + ".Q";
+      }
+      if (!args->empty()) *args += ", ";
+      *args += named ? in.formal + " := " + v : v;
+    }
+    return true;
+  }
+
+  // The value at output `formal` of block e: a function's call, written where it is used,
+  // or a function block instance's output (before the instance's call in this evaluation:
+  // the previous value, a feedback path).
+  bool block_value(const Element& e, const std::string& formal, const pugi::xml_node& user, std::string* v) {
+    const std::string inst = inst_of(e);
+    if (!inst.empty()) {
+      if (formal == "ENO") {
+        enos_.insert(e.id);
+        *v = "_ldeno" + std::to_string(e.id);
+      } else {
+        *v = (output_negated(e, formal) ? "NOT " : "") + inst + "." + (formal.empty() ? "Q" : formal);
+      }
+      return true;
+    }
+    std::string en;
+    if (!enable(e, &en)) return false;
+    if (!en.empty() || formal == "ENO")
+      return fail(user, "reads function " + type_of(e) + " (localId " + std::to_string(e.id) +
+                            "), whose EN or ENO is connected: connect its value straight to an output variable, "
+                            "where plcfi assigns it under EN");
+    if (++depth_ > kMaxDepth) return fail(e.n, "function boxes nest too deep");
+    std::string args;
+    const bool ok = arguments(e, false, &args);
+    --depth_;
+    if (!ok) return false;
+    *v = (output_negated(e, formal) ? "NOT " : "") + type_of(e) + "(" + args + ")";
     return true;
   }
 
@@ -267,47 +408,62 @@ class Translator {
       const std::string target = expression(e);
       if (target.empty()) return fail(e.n, "<" + e.kind + "> has no <expression>");
       if (e.inputs.empty() || e.inputs.front().from.empty()) return true;
+      const bool negated = e.n.attribute("negated").as_bool();
+      if (const Element* f = enabled_function(e.inputs.front())) {
+        // target := F(EN := en, ..., ENO => _ldenoN): with EN FALSE the target keeps its value.
+        std::string en, args;
+        if (negated) return fail(e.n, "a negated output of function " + type_of(*f) + " with EN: plcfi cannot assign it under EN");
+        if (!enable(*f, &en) || !arguments(*f, true, &args)) return false;
+        flush_pending(e);
+        enos_.insert(f->id);
+        line(target + " := " + type_of(*f) + "(EN := " + en + (args.empty() ? "" : ", " + args) + ", ENO => _ldeno" +
+                 std::to_string(f->id) + ");",
+             e);
+        return true;
+      }
       std::string in;
       if (!input(e, e.inputs.front(), &in)) return false;
-      line(target + " := " + in + ";", e);
+      flush_pending(e);
+      line(target + " := " + (negated ? "NOT (" + in + ")" : in) + ";", e);
       return true;
     }
     if (e.kind == "block") return block(e);
     return true;  // power rails, in-variables, connectors, continuations: values only
   }
 
+  // The function with EN connected whose value `in` takes directly, if any.
+  const Element* enabled_function(const Input& in) {
+    if (in.from.size() != 1 || in.negated) return nullptr;
+    auto it = by_id_.find(in.from.front().ref);
+    if (it == by_id_.end()) return nullptr;
+    const Element& f = elements_[it->second];
+    if (f.kind != "block" || !inst_of(f).empty()) return nullptr;
+    for (const auto& x : f.inputs)
+      if (x.formal == "EN" && !x.from.empty()) return &f;
+    return nullptr;
+  }
+
+  // Edge detectors of block inputs, called before the statement that reads them.
+  void flush_pending(const Element& e) {
+    for (const auto& p : pending_) line(p, e);
+    pending_.clear();
+  }
+
+  // A function block call is a statement (with EN/ENO as ST writes them); a function is a
+  // value, written where it is used (block_value).
   bool block(const Element& e) {
-    const std::string type = trimmed(e.n.attribute("typeName").value());
-    const std::string inst = trimmed(e.n.attribute("instanceName").value());
-    if (type.empty()) return fail(e.n, "<block> has no typeName");
+    if (type_of(e).empty()) return fail(e.n, "<block> has no typeName");
+    const std::string inst = inst_of(e);
+    if (inst.empty()) return true;
     std::string en, args;
-    bool has_en = false;
-    for (const auto& in : e.inputs) {
-      std::string v;
-      if (!input(e, in, &v)) return false;
-      if (in.formal == "EN") {
-        has_en = v != "TRUE";  // EN on the left rail: always enabled
-        en = v;
-        continue;
-      }
-      if (in.from.empty()) continue;
-      if (!args.empty()) args += ", ";
-      args += inst.empty() ? v : in.formal + " := " + v;
-    }
-    auto& outs = block_out_[e.id];
-    if (inst.empty()) {
-      // A function: its value is the call, written where it is used.
-      if (has_en) return fail(e.n, "function " + type + " has EN connected: plcfi translates EN on function block calls only");
-      outs[""] = type + "(" + args + ")";
-      return true;
-    }
-    const std::string call = inst + "(" + args + ");";
-    if (has_en) line("IF " + en + " THEN " + call + " END_IF;", e);
-    else line(call, e);
-    for (auto v : child(e.n, "outputVariables").children()) {
-      if (!is(v, "variable")) continue;
-      const std::string formal = v.attribute("formalParameter").value();
-      outs[formal] = formal == "ENO" ? (has_en ? en : std::string("TRUE")) : inst + "." + formal;
+    if (!enable(e, &en) || !arguments(e, true, &args)) return false;
+    flush_pending(e);
+    if (en.empty()) {
+      line(inst + "(" + args + ");", e);
+      if (enos_.count(e.id)) line("_ldeno" + std::to_string(e.id) + " := TRUE;", e);
+    } else {
+      enos_.insert(e.id);
+      line(inst + "(EN := " + en + (args.empty() ? "" : ", " + args) + ", ENO => _ldeno" + std::to_string(e.id) + ");", e);
     }
     return true;
   }
@@ -316,21 +472,24 @@ class Translator {
   static constexpr size_t kMaxText = 64 * 1024;
   int depth_ = 0;
   std::string what_;
+  bool fbd_;
   bool instances_;
   LdTranslation* out_;
   LdError* err_;
   std::vector<Element> elements_;
   std::map<long, size_t> by_id_;
   std::map<std::string, long> connectors_;
-  std::map<long, std::map<std::string, std::string>> block_out_;
   std::vector<long> temps_;
+  std::set<long> enos_;                                        // blocks whose ENO is read
+  std::vector<std::pair<std::string, std::string>> edge_inputs_;  // edge-sensing inputs: name, type
+  std::vector<std::string> pending_;                           // their calls, before the next statement
   std::map<long, std::string> edges_;
 };
 
 }  // namespace
 
 bool ld_to_st(const pugi::xml_node& ld, const std::string& what, bool instances, LdTranslation* out, LdError* err) {
-  Translator t(what, instances, out, err);
+  Translator t(what, is(ld, "FBD"), instances, out, err);
   return t.run(ld);
 }
 

@@ -1,15 +1,20 @@
-// Ladder Diagram bodies of PLCopen XML (TC6 2.01 <LD>) translated to ST, so a project with
-// an LD POU runs like one written in ST. The network is a graph: every element names the
-// elements its input is connected to (connectionPointIn/connection refLocalId); several
-// connections into one input are a parallel branch (OR). Elements are evaluated in an
-// order that respects the connections, ties kept in document order (the rungs top to
-// bottom); a loop in the graph is an error.
+// Ladder Diagram and Function Block Diagram bodies of PLCopen XML (TC6 2.01 <LD>, <FBD>)
+// translated to ST, so a project with such a POU runs like one written in ST. The network
+// is a graph: every element names the elements its input is connected to
+// (connectionPointIn/connection refLocalId); several connections into one input are a
+// parallel branch (OR). Elements are evaluated in an order that respects the connections,
+// ties kept in document order (the rungs top to bottom); in FBD, executionOrderId on
+// every element that does something gives the order instead. A loop through an in-out
+// variable or a function block's output is a feedback path: that connection reads the
+// previous value (the variable, the instance's output). Any other loop is an error.
 //
 // Supported: left and right power rails; contacts (normally open, negated, rising and
 // falling edge); coils (plain, negated, set, reset, rising and falling edge); function and
-// function block calls (<block>, with EN/ENO); input, output and in-out variables;
-// connectors and continuations; comments. Anything else (jumps, labels, returns) is an
-// error naming the element.
+// function block calls (<block>; EN/ENO as ST has them; negated inputs and outputs; edges
+// on function block inputs); input (negated), output (negated) and in-out variables;
+// connectors and continuations; comments. A function's value is written where it is used;
+// one with EN connected must feed an output variable (assigned under EN). Anything else
+// (jumps, labels, returns) is an error naming the element.
 #pragma once
 
 #include <string>

@@ -681,9 +681,11 @@ class Importer {
       header(keyword, p, iface, extends);
       var_blocks(iface, what);
     }
-    // A Ladder Diagram body becomes ST (import/ld.hpp); its variables come first.
+    // A Ladder Diagram or Function Block Diagram body becomes ST (import/ld.hpp); its
+    // variables come first.
     LdTranslation ld;
     pugi::xml_node ld_body = child(child(p, "body"), "LD");
+    if (!ld_body) ld_body = child(child(p, "body"), "FBD");
     if (ld_body) {
       LdError err;
       if (!ld_to_st(ld_body, what, keyword != "FUNCTION", &ld, &err)) return error(err.code.c_str(), err.at, err.message);
