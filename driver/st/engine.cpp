@@ -16,6 +16,7 @@
 #include "import/import.hpp"
 #include "syntax/parser.hpp"
 #include "vm/natives.hpp"
+#include "vm/wide.hpp"
 
 namespace plcfi::st {
 
@@ -626,10 +627,11 @@ std::string format(const Machine& m, const VarHandle& h) {
     case TypeKind::Date: return date_literal(load_as<int64_t>(p));
     case TypeKind::TimeOfDay: return tod_literal(load_as<int64_t>(p));
     case TypeKind::DateTime: return dt_literal(load_as<int64_t>(p));
-    case TypeKind::String: case TypeKind::WString: {
+    case TypeKind::String: {
       const char* s = reinterpret_cast<const char*>(p);
       return "'" + std::string(s, strnlen(s, t->str_len)) + "'";
     }
+    case TypeKind::WString: return "'" + utf16_to_utf8(load_wstring(p, t->str_len)) + "'";  // users read UTF-8
     case TypeKind::Enum: {
       int64_t v = read_int(m, h);
       for (const auto& [n, x] : t->enum_values)
@@ -681,6 +683,10 @@ bool write_text(Machine& m, const VarHandle& h, std::string_view text, std::stri
   };
   if (t->is_string()) {
     if (l.lit != LiteralKind::String && l.lit != LiteralKind::WString) return bad_kind();
+    if (t->kind == TypeKind::WString) {  // the literal's UTF-8 as the WSTRING's UTF-16
+      store_wstring(m.mem() + h.addr, t->str_len, utf8_to_utf16(l.str_value));
+      return true;
+    }
     size_t n = std::min<size_t>(l.str_value.size(), t->str_len);
     std::memcpy(m.mem() + h.addr, l.str_value.data(), n);
     m.mem()[h.addr + n] = 0;

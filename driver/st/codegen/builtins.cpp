@@ -53,8 +53,9 @@ const Type* real_of(Compiler& cc, const Type* t) {
   return t && t->kind == TypeKind::Real ? t : cc.elem(TypeKind::LReal);
 }
 
-// A string function's STRING operand.
-std::optional<Slot> str_arg(Compiler& cc, const Expr* e, std::string_view fn) {
+// A string function's string operand, evaluated; its representation is decided once all
+// operands are known (Compiler::string_slot).
+std::optional<Val> str_val(Compiler& cc, const Expr* e, std::string_view fn) {
   Val v = cc.expr(*e);
   if (!v.ok) return std::nullopt;
   const Type* t = v.type ? v.type : cc.default_type(v.c);
@@ -62,8 +63,20 @@ std::optional<Slot> str_arg(Compiler& cc, const Expr* e, std::string_view fn) {
     cc.diags_.error("ST203", e->loc, std::string(fn) + " needs a STRING here, not " + t->name);
     return std::nullopt;
   }
-  return v.is_const ? cc.konst(t, v.c, e->loc) : v.slot;
+  return v;
 }
+
+// A string function's STRING operand (a WSTRING converted to its UTF-8 text).
+std::optional<Slot> str_arg(Compiler& cc, const Expr* e, std::string_view fn) {
+  auto v = str_val(cc, e, fn);
+  if (!v) return std::nullopt;
+  return cc.string_slot(*v, false, e->loc);
+}
+
+// The string functions take ANY_STRING (IEC 61131-3): their operands in one representation,
+// WSTRING when any of them is one; a STRING among WSTRINGs is converted, as its assignment
+// to a WSTRING would be, never reinterpreted.
+bool is_wide(const Val& v) { return v.type && v.type->kind == TypeKind::WString; }
 
 // A string function's integer operand (a length, a position), passed as LINT.
 std::optional<Slot> int_arg(Compiler& cc, const Expr* e, std::string_view fn) {
@@ -255,7 +268,7 @@ Val Compiler::native(Native n, const Type* result, std::initializer_list<Slot> a
 }
 
 Val Compiler::native_list(Native n, const Type* result, const std::vector<Slot>& args, uint32_t cap) {
-  Slot d = result->is_string() ? temp(result->size, 1) : temp_for(result);
+  Slot d = result->is_string() ? temp(result->size, result->align) : temp_for(result);
   Arg a[4] = {0u, 0u, 0u, 0u};
   size_t i = 0;
   for (Slot s : args) a[i++] = Arg(s);
@@ -285,6 +298,23 @@ std::optional<Val> Compiler::builtin(const std::string& name, const CallExpr& c)
 }
 
 // ------------------------------------------------------------------ conversions
+
+// The text of a value as TO_STRING gives it: a STRING[80].
+Val Compiler::to_string_text(Slot s, const Type* from) {
+  const Type* st = tt_->string_type(80, false);
+  const TypeKind fk = from->kind;
+  if (fk == TypeKind::Bool) return native(Native::BOOL_TO_S, st, {s}, 80);
+  if (fk == TypeKind::LTime && from->unsigned_count) return native(Native::LTIME_U_TO_S, st, {s}, 80);
+  if (fk == TypeKind::Time || fk == TypeKind::LTime) return native(Native::TIME_TO_S, st, {s}, 80);
+  if (fk == TypeKind::Date) return native(Native::DATE_TO_S, st, {s}, 80);
+  if (fk == TypeKind::TimeOfDay) return native(Native::TOD_TO_S, st, {s}, 80);
+  if (fk == TypeKind::DateTime) return native(Native::DT_TO_S, st, {s}, 80);
+  if (fk == TypeKind::Real) return native(Native::F32_TO_S, st, {s}, 80);
+  if (fk == TypeKind::LReal) return native(Native::F64_TO_S, st, {s}, 80);
+  if (from->is_unsigned_int() || from->is_bitstring())
+    return native(Native::U64_TO_S, st, {convert(s, from, elem(TypeKind::ULInt))}, 80);
+  return native(Native::I64_TO_S, st, {convert(s, from, elem(TypeKind::LInt))}, 80);
+}
 
 std::optional<Val> Compiler::conversion(const std::string& name, const ConversionName& conv, const CallExpr& c) {
   const Type* from = conv.from;
@@ -347,22 +377,14 @@ std::optional<Val> Compiler::conversion(const std::string& name, const Conversio
       emit(fk == TypeKind::Real ? Op::TRUNC_F32 : Op::TRUNC_F64, {t, s});
       return slot_val(to, convert(t, from, to));
     }
-    case ConversionKind::StringCopy: return slot_val(from, s);
+    case ConversionKind::StringCopy: return restring(s, from, tk == TypeKind::WString);
     case ConversionKind::ToString: {
-      const Type* st = tt_->string_type(80, tk == TypeKind::WString);
-      if (fk == TypeKind::Bool) return native(Native::BOOL_TO_S, st, {s}, 80);
-      if (fk == TypeKind::LTime && from->unsigned_count) return native(Native::LTIME_U_TO_S, st, {s}, 80);
-      if (fk == TypeKind::Time || fk == TypeKind::LTime) return native(Native::TIME_TO_S, st, {s}, 80);
-      if (fk == TypeKind::Date) return native(Native::DATE_TO_S, st, {s}, 80);
-      if (fk == TypeKind::TimeOfDay) return native(Native::TOD_TO_S, st, {s}, 80);
-      if (fk == TypeKind::DateTime) return native(Native::DT_TO_S, st, {s}, 80);
-      if (fk == TypeKind::Real) return native(Native::F32_TO_S, st, {s}, 80);
-      if (fk == TypeKind::LReal) return native(Native::F64_TO_S, st, {s}, 80);
-      if (from->is_unsigned_int() || from->is_bitstring())
-        return native(Native::U64_TO_S, st, {convert(s, from, elem(TypeKind::ULInt))}, 80);
-      return native(Native::I64_TO_S, st, {convert(s, from, I64)}, 80);
+      // The text is computed as a STRING; TO_WSTRING converts it.
+      Val text = to_string_text(s, from);
+      return tk == TypeKind::WString ? restring(text.slot, text.type, true) : text;
     }
     case ConversionKind::FromString: {
+      s = restring(s, from, false).slot;  // WSTRING_TO_INT parses the text of the WSTRING
       if (tk == TypeKind::Bool) return native(Native::S_TO_BOOL, to, {s});
       if (to->is_real()) {
         Val r = native(Native::S_TO_F64, F64, {s});
@@ -564,9 +586,9 @@ std::optional<Val> Compiler::emit_select(const StdFunc& f, const CallExpr& c) {
     if (!cv.ok) return bad();
     slots.push_back(to_slot(cv, t, ins[i]->loc));
   }
-  Slot d = t->is_string() ? temp(t->size, 1) : temp_for(t);
+  Slot d = t->is_string() ? temp(t->size, t->align) : temp_for(t);
   auto copy = [&](Slot src) {
-    if (t->is_string()) emit(Op::SCPY, {d, src, t->str_len});
+    if (t->is_string()) emit(string_copy_op(t), {d, src, t->str_len});
     else if (t->size == 1 || t->size == 2 || t->size == 4 || t->size == 8) emit(mov_op(t->size), {d, src});
     else emit(Op::MOVN, {d, src, t->size});
   };
@@ -693,49 +715,64 @@ std::optional<Val> Compiler::emit_shift(const StdFunc& f, const CallExpr& c) {
 
 // ------------------------------------------------------------------ strings
 
-// Results of the string functions are STRING[255].
+// Results of the string functions are STRING[255], on WSTRINGs WSTRING[255]; lengths and
+// positions count bytes of a STRING, code units of a WSTRING.
 std::optional<Val> Compiler::emit_string(const StdFunc& f, const CallExpr& c) {
   auto args = positional(c, f);
   if (args.empty()) return bad();
-  std::vector<Slot> slots;
+  std::vector<std::optional<Val>> strs(args.size());
+  std::vector<Slot> slots(args.size());
+  bool wide = false;
   for (size_t i = 0; i < args.size(); ++i) {
-    auto s = f.operands[i] == 'S' ? str_arg(*this, args[i], f.name) : int_arg(*this, args[i], f.name);
-    if (!s) return bad();
-    slots.push_back(*s);
+    if (f.operands[i] == 'S') {
+      strs[i] = str_val(*this, args[i], f.name);
+      if (!strs[i]) return bad();
+      wide = wide || is_wide(*strs[i]);
+    } else {
+      auto s = int_arg(*this, args[i], f.name);
+      if (!s) return bad();
+      slots[i] = *s;
+    }
   }
-  return native_list(f.native, f.int_result ? elem(TypeKind::Int) : tt_->string_type(255, false), slots,
-                     f.int_result ? 0 : 255);
+  for (size_t i = 0; i < args.size(); ++i)
+    if (strs[i]) slots[i] = string_slot(*strs[i], wide, args[i]->loc);
+  return native_list(wide ? wide_native(f.native) : f.native,
+                     f.int_result ? elem(TypeKind::Int) : tt_->string_type(255, wide), slots, f.int_result ? 0 : 255);
 }
 
 std::optional<Val> Compiler::emit_concat(const StdFunc& f, const CallExpr& c) {
-  const Type* rstr = tt_->string_type(255, false);
   auto args = positional(c, f);
   if (args.empty()) return bad();
-  auto s = str_arg(*this, args[0], f.name);
-  if (!s) return bad();
-  Slot acc = *s;
-  for (size_t i = 1; i < args.size(); ++i) {
-    auto n = str_arg(*this, args[i], f.name);
-    if (!n) return bad();
-    acc = native(Native::S_CONCAT, rstr, {acc, *n}, 255).slot;
+  std::vector<Val> vals;
+  bool wide = false;
+  for (const Expr* a : args) {
+    auto v = str_val(*this, a, f.name);
+    if (!v) return bad();
+    wide = wide || is_wide(*v);
+    vals.push_back(*v);
   }
+  const Type* rstr = tt_->string_type(255, wide);
+  Slot acc = string_slot(vals[0], wide, args[0]->loc);
+  for (size_t i = 1; i < args.size(); ++i)
+    acc = native(wide ? Native::W_CONCAT : Native::S_CONCAT, rstr, {acc, string_slot(vals[i], wide, args[i]->loc)}, 255).slot;
   return slot_val(rstr, acc);
 }
 
 std::optional<Val> Compiler::emit_replace(const StdFunc& f, const CallExpr& c) {
-  const Type* rstr = tt_->string_type(255, false);
   auto args = positional(c, f);
   if (args.empty()) return bad();
-  auto a = str_arg(*this, args[0], f.name);
-  auto b = str_arg(*this, args[1], f.name);
+  auto a = str_val(*this, args[0], f.name);
+  auto b = str_val(*this, args[1], f.name);
   auto l = int_arg(*this, args[2], f.name);
   auto p = int_arg(*this, args[3], f.name);
   if (!a || !b || !l || !p) return bad();
+  const bool wide = is_wide(*a) || is_wide(*b);
   // The native takes three operands: length and position go as one pair.
   Slot lp = temp(16, 8);
   emit(Op::MOV8, {lp, *l});
   emit(Op::MOV8, {lp.plus(8), *p});
-  return native(Native::S_REPLACE, rstr, {*a, *b, lp}, 255);
+  return native(wide ? Native::W_REPLACE : Native::S_REPLACE, tt_->string_type(255, wide),
+                {string_slot(*a, wide, args[0]->loc), string_slot(*b, wide, args[1]->loc), lp}, 255);
 }
 
 // ------------------------------------------------------------------ memory, clock
@@ -974,7 +1011,7 @@ std::optional<Val> Compiler::emit_assert(const StdFunc& f, const CallExpr& c) {
       diags_.error("ST203", args.back()->loc, "the assertion message must be a string");
       return bad();
     }
-    msg = m.is_const ? konst(m.type, m.c, args.back()->loc) : m.slot;
+    msg = string_slot(m, false, args.back()->loc);  // the message is shown as UTF-8
   }
   auto emit_assert = [&](uint32_t kindword, Slot a, Slot b, Slot tol) {
     mark(c.loc);
@@ -1023,7 +1060,8 @@ std::optional<Val> Compiler::emit_assert(const StdFunc& f, const CallExpr& c) {
   }
   const Type* t = first_type(*this, vals);
   if (vals[0].type && vals[1].type && vals[0].type->kind == TypeKind::Enum && vals[0].type != vals[1].type) t = nullptr;
-  if (vals[0].type && vals[1].type && vals[0].type->is_string() && vals[1].type->is_string()) t = vals[0].type;
+  if (vals[0].type && vals[1].type && vals[0].type->is_string() && vals[1].type->is_string())
+    t = is_wide(vals[0]) || is_wide(vals[1]) ? tt_->string_type(255, true) : vals[0].type;
   if (!t) {
     auto what = [](const Val& v) { return v.type ? v.type->name : std::string("a literal"); };
     diags_.error("ST203", c.loc, name + ": cannot compare " + what(vals[0]) + " with " + what(vals[1]));
@@ -1032,8 +1070,9 @@ std::optional<Val> Compiler::emit_assert(const StdFunc& f, const CallExpr& c) {
   Val c0 = coerce(vals[0], t, args[0]->loc, name.c_str());
   Val c1 = coerce(vals[1], t, args[1]->loc, name.c_str());
   if (!c0.ok || !c1.ok) return bad();
-  Slot a = t->is_string() && c0.is_const ? konst(vals[0].type, c0.c, args[0]->loc) : to_slot(c0, t, args[0]->loc);
-  Slot b = t->is_string() && c1.is_const ? konst(vals[1].type, c1.c, args[1]->loc) : to_slot(c1, t, args[1]->loc);
+  const bool wide = t->kind == TypeKind::WString;
+  Slot a = t->is_string() ? string_slot(c0, wide, args[0]->loc) : to_slot(c0, t, args[0]->loc);
+  Slot b = t->is_string() ? string_slot(c1, wide, args[1]->loc) : to_slot(c1, t, args[1]->loc);
   emit_assert((static_cast<uint32_t>(kind) << 8) | static_cast<uint32_t>(value_kind(t)), a, b, a);
   return void_val(*this);
 }

@@ -723,7 +723,7 @@ Val Compiler::call_fb(const Place& inst_in, PouInfo* fb, const CallExpr& c, PouI
     field.off = inst.off + p->offset;
     Val v = load(field);
     if (dst_calls && v.slot.kind == SK::Var) {
-      Slot copy = p->type->is_string() ? temp(p->type->size, 1) : temp_for(p->type);
+      Slot copy = p->type->is_string() ? temp(p->type->size, p->type->align) : temp_for(p->type);
       store(frame_place(copy, p->type), v.slot);
       v.slot = copy;
     }
@@ -885,7 +885,7 @@ Val Compiler::call_method(const std::vector<CallArg>& args, SourceLoc loc, PouIn
     bool from_variable = !st.v.is_const && (st.v.slot.kind == SK::Var || st.v.slot.kind == SK::Hidden);
     if (from_variable && call_after[k]) {
       const Type* t = p->where == Where::InOut ? elem(TypeKind::UDInt) : p->type;
-      Slot copy = t->is_string() ? temp(t->size, 1) : temp_for(t);
+      Slot copy = t->is_string() ? temp(t->size, t->align) : temp_for(t);
       Place dst = frame_place(copy, t);
       assign(dst, st.v, a->loc);
       st.v.type = t;

@@ -93,7 +93,8 @@ ValueKind value_kind(const Type* t) {
     case TypeKind::Date: return ValueKind::Date;
     case TypeKind::TimeOfDay: return ValueKind::Tod;
     case TypeKind::DateTime: return ValueKind::Dt;
-    case TypeKind::String: case TypeKind::WString: return ValueKind::String;
+    case TypeKind::String: return ValueKind::String;
+    case TypeKind::WString: return ValueKind::WString;
     case TypeKind::Ref: case TypeKind::Interface: return ValueKind::Ref;
     default: break;
   }

@@ -21,6 +21,7 @@
 #include "codegen/compiler.hpp"
 #include "vm/natives.hpp"
 #include "vm/vm.hpp"
+#include "vm/wide.hpp"
 
 namespace plcfi::st {
 struct StdFunc;
@@ -289,6 +290,11 @@ class Compiler {
   Val coerce(const Val& v, const Type* to, SourceLoc loc, const char* what);
   Slot to_slot(const Val& v, const Type* t, SourceLoc loc);
   Slot convert(Slot s, const Type* from, const Type* to);
+  // A string in the other representation (STRING <-> WSTRING, UTF-8 <-> UTF-16).
+  Val restring(Slot s, const Type* from, bool wide);
+  // A string value (a constant too) as a STRING or, wide, a WSTRING: mixing the two
+  // converts the text, never reinterprets its bytes.
+  Slot string_slot(const Val& v, bool wide, SourceLoc loc);
   Val cond(const Expr& e);
   // Emits "jump to target when the condition is false (or true)"; a comparison that was
   // just computed into a temporary becomes one fused compare-and-jump instruction.
@@ -434,6 +440,7 @@ class Compiler {
   std::vector<const Expr*> positional(const CallExpr& c, size_t min, size_t max, std::string_view name);
   std::vector<const Expr*> positional(const CallExpr& c, const StdFunc& f);  // f's argument counts
   Val native(Native n, const Type* result, std::initializer_list<Slot> args, uint32_t cap = 0);
+  Val to_string_text(Slot s, const Type* from);
   Val native_list(Native n, const Type* result, const std::vector<Slot>& args, uint32_t cap = 0);
   // One emitter per StdFamily (SEL and MUX share one).
   std::optional<Val> emit_math(const StdFunc& f, const CallExpr& c);
@@ -543,5 +550,7 @@ Op int_op(Op i8_variant, Storage s);
 Op cvt_op(Storage from, Storage to);
 Op mov_op(uint32_t size);  // 1, 2, 4, 8; else MOVN
 ValueKind value_kind(const Type* t);
+// The copy of a string of type t into a string of its kind: SCPY bytes, WSCPY code units.
+inline Op string_copy_op(const Type* t) { return t->kind == TypeKind::WString ? Op::WSCPY : Op::SCPY; }
 
 }  // namespace plcfi::st::detail

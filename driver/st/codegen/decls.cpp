@@ -694,6 +694,10 @@ bool Compiler::write_const(uint8_t* dst, const Type* t, const ConstV& c, SourceL
       diags_.error("ST203", loc, "a string is required for " + t->name);
       return false;
     }
+    if (t->kind == TypeKind::WString) {  // source text is UTF-8, a WSTRING UTF-16
+      store_wstring(dst, t->str_len, utf8_to_utf16(c.s));
+      return true;
+    }
     size_t n = std::min<size_t>(c.s.size(), t->str_len);
     std::memcpy(dst, c.s.data(), n);
     dst[n] = 0;

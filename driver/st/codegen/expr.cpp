@@ -304,6 +304,7 @@ Slot Compiler::to_slot(const Val& v, const Type* t, SourceLoc loc) {
 
 Slot Compiler::convert(Slot s, const Type* from, const Type* to) {
   if (!from || !to || from == to) return s;
+  if (from->is_string() && to->is_string() && from->kind != to->kind) return restring(s, from, to->kind == TypeKind::WString).slot;
   Storage a = from->storage(), b = to->storage();
   if (a == b || a == Storage::Block || b == Storage::Block) return s;
   // Between integers of one width a conversion only reinterprets the bits (two's
@@ -321,6 +322,23 @@ Slot Compiler::convert(Slot s, const Type* from, const Type* to) {
   def(t);
   if (s.kind == SK::Var) b_->cvt_cache[key] = t;
   return t;
+}
+
+Val Compiler::restring(Slot s, const Type* from, bool wide) {
+  Val out;
+  out.type = from;
+  out.slot = s;
+  if ((from->kind == TypeKind::WString) == wide) return out;
+  // Room for the whole source (a code unit takes up to 3 bytes of UTF-8): the
+  // destination's own capacity truncates when the result is stored.
+  const uint32_t cap = wide ? from->str_len : std::min<uint32_t>(3 * from->str_len, 0xFFFF);
+  return native(wide ? Native::S_TO_W : Native::W_TO_S, tt_->string_type(cap, wide), {s}, cap);
+}
+
+Slot Compiler::string_slot(const Val& v, bool wide, SourceLoc loc) {
+  const Type* t = v.type ? v.type : default_type(v.c);
+  if (v.is_const) return konst(tt_->string_type(t->str_len, wide), v.c, loc);  // a unit per byte at most
+  return restring(v.slot, t, wide).slot;
 }
 
 // ------------------------------------------------------------------ expressions
@@ -358,7 +376,9 @@ Val Compiler::literal(const LiteralExpr& l, const Type* expected) {
       return v;
     case LiteralKind::String:
     case LiteralKind::WString:
-      v.type = tt_->string_type(std::max<uint32_t>(1, static_cast<uint32_t>(l.str_value.size())), l.lit == LiteralKind::WString);
+      v.type = l.lit == LiteralKind::WString
+                   ? tt_->string_type(std::max<uint32_t>(1, static_cast<uint32_t>(utf8_to_utf16(l.str_value).size())), true)
+                   : tt_->string_type(std::max<uint32_t>(1, static_cast<uint32_t>(l.str_value.size())), false);
       return v;
     case LiteralKind::Time: v.type = elem(l.is_long ? TypeKind::LTime : TypeKind::Time); return v;
     case LiteralKind::Date: v.type = l.is_long ? tt_->long_date(TypeKind::Date) : elem(TypeKind::Date); return v;
@@ -851,11 +871,13 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   // Strings: comparisons only.
   if (lt->is_string() || rt->is_string()) {
     if (!lt->is_string() || !rt->is_string() || !is_cmp(e.op)) return op_error();
-    Slot a = l.is_const ? konst(lt, l.c, e.loc) : l.slot;
-    Slot b = r.is_const ? konst(rt, r.c, e.loc) : r.slot;
+    // A STRING compared with a WSTRING is converted to one (as the assignment would).
+    const bool wide = lt->kind == TypeKind::WString || rt->kind == TypeKind::WString;
+    Slot a = string_slot(l, wide, e.loc);
+    Slot b = string_slot(r, wide, e.loc);
     Slot d = temp(1, 1);
     static const uint32_t kRel[] = {2, 4, 3, 5, 0, 1};  // Lt Gt Le Ge Eq Ne -> SCMP relation
-    emit(Op::SCMP, {d, a, b, kRel[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)]});
+    emit(wide ? Op::WSCMP : Op::SCMP, {d, a, b, kRel[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)]});
     def(d);
     Val v;
     v.type = elem(TypeKind::Bool);

@@ -827,13 +827,13 @@ void Compiler::store(const Place& p, Slot src) {
   }
   uint32_t size = t->size;
   if (t->is_string() && p.k == Place::K::Frame) {
-    emit(Op::SCPY, {Slot{p.off, p.sk}, src, t->str_len});
+    emit(string_copy_op(t), {Slot{p.off, p.sk}, src, t->str_len});
     return;
   }
   if (t->is_string()) {
     // Truncate to the destination's capacity in a temporary, then copy the buffer.
-    Slot tmp = temp(size, 1);
-    emit(Op::SCPY, {tmp, src, t->str_len});
+    Slot tmp = temp(size, t->align);
+    emit(string_copy_op(t), {tmp, src, t->str_len});
     src = tmp;
   }
   switch (p.k) {

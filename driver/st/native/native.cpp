@@ -213,7 +213,7 @@ class Translator {
       case Op::LDG1: case Op::LDG2: case Op::LDG4: case Op::LDG8: case Op::LDGN:
       case Op::STG1: case Op::STG2: case Op::STG4: case Op::STG8: case Op::STGN:
       case Op::LDBIT: case Op::STBIT: case Op::ADDR: case Op::ADDRK: case Op::INITBLK: case Op::NOW: case Op::ADVTIME:
-      case Op::NATIVE: case Op::SCPY: case Op::SCMP:
+      case Op::NATIVE: case Op::SCPY: case Op::SCMP: case Op::WSCPY: case Op::WSCMP:
       case Op::GETBIT1: case Op::GETBIT2: case Op::GETBIT4: case Op::GETBIT8:
       case Op::SETBIT1: case Op::SETBIT2: case Op::SETBIT4: case Op::SETBIT8:
       case Op::BAND: case Op::BOR: case Op::BXOR: case Op::BNOT: case Op::RISE: case Op::FALL:
@@ -525,13 +525,15 @@ class Translator {
                         "std::memmove(base + {0}, src, n); base[{0} + n] = 0;",
                         K(1), K(2), K(3));
         return true;
-      case Op::SCMP: {
+      case Op::SCMP:
+      case Op::WSCMP: {
         const char* rel[] = {"== 0", "!= 0", "< 0", "<= 0", "> 0", ">= 0"};
-        s = W("uint8_t", 1,
-              fmt::format("(uint8_t)(std::strcmp((const char*)(base + {}), (const char*)(base + {})) {})", K(2), K(3),
-                          rel[std::min<uint32_t>(w[4], 5)]));
+        std::string cmp = op == Op::SCMP ? fmt::format("std::strcmp((const char*)(base + {}), (const char*)(base + {}))", K(2), K(3))
+                                         : fmt::format("wscmp(base + {}, base + {})", K(2), K(3));
+        s = W("uint8_t", 1, fmt::format("(uint8_t)({} {})", cmp, rel[std::min<uint32_t>(w[4], 5)]));
         return true;
       }
+      case Op::WSCPY: s = fmt::format("wscpy(base + {}, base + {}, {});", K(1), K(2), K(3)); return true;
       case Op::GETBIT1: s = W("uint8_t", 1, fmt::format("(uint8_t)(({} >> {}) & 1u)", R("uint8_t", 2), K(3))); return true;
       case Op::GETBIT2: s = W("uint8_t", 1, fmt::format("(uint8_t)(({} >> {}) & 1u)", R("uint16_t", 2), K(3))); return true;
       case Op::GETBIT4: s = W("uint8_t", 1, fmt::format("(uint8_t)(({} >> {}) & 1u)", R("uint32_t", 2), K(3))); return true;
@@ -725,7 +727,7 @@ class Translator {
       case Op::LDG1: case Op::LDG2: case Op::LDG4: case Op::LDG8:
       case Op::LDI1: case Op::LDI2: case Op::LDI4: case Op::LDI8:
       case Op::LDBIT: case Op::ADDR: case Op::ADDRI: case Op::ADDRK: case Op::ELEM: case Op::NOW: case Op::ADVTIME:
-      case Op::SCMP: case Op::GETBIT1: case Op::GETBIT2: case Op::GETBIT4: case Op::GETBIT8:
+      case Op::SCMP: case Op::WSCMP: case Op::GETBIT1: case Op::GETBIT2: case Op::GETBIT4: case Op::GETBIT8:
       case Op::SETBIT1: case Op::SETBIT2: case Op::SETBIT4: case Op::SETBIT8:
       case Op::BAND: case Op::BOR: case Op::BXOR: case Op::BNOT: case Op::RISE: case Op::FALL:
       case Op::STEADY_HIGH: case Op::STEADY_LOW: case Op::TOBOOL8: case Op::TOBOOL16: case Op::TOBOOL32: case Op::TOBOOL64:
@@ -735,6 +737,7 @@ class Translator {
       case Op::MOVN: case Op::LDGN: case Op::INITBLK: return range(w[1], w[3]);
       case Op::LDIN: return range(w[1], w[4]);
       case Op::SCPY: return range(w[1], uint64_t{w[3]} + 1);
+      case Op::WSCPY: return range(w[1], 2 * (uint64_t{w[3]} + 1));
       case Op::FBENTER: return range(4, 4);
       case Op::NATIVE: {
         std::string ignored;

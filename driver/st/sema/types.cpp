@@ -22,7 +22,7 @@ constexpr ElemSpec kElementary[] = {
     {TypeKind::LReal, "LREAL", 8},      {TypeKind::Time, "TIME", 8},
     {TypeKind::LTime, "LTIME", 8},      {TypeKind::Date, "DATE", 8},
     {TypeKind::TimeOfDay, "TIME_OF_DAY", 8}, {TypeKind::DateTime, "DATE_AND_TIME", 8},
-    {TypeKind::String, "STRING", 81},   {TypeKind::WString, "WSTRING", 81},
+    {TypeKind::String, "STRING", 81},   {TypeKind::WString, "WSTRING", 162},
     {TypeKind::Array, "<array>", 0},    {TypeKind::Struct, "<struct>", 0},
     {TypeKind::Enum, "<enum>", 0},      {TypeKind::Ref, "<ref>", 4},
     {TypeKind::Pou, "<pou>", 0},        {TypeKind::Interface, "<interface>", 4},
@@ -47,7 +47,8 @@ TypeTable::TypeTable() {
     t->kind = e.kind;
     t->name = e.name;
     t->size = e.size;
-    t->align = e.kind == TypeKind::String || e.kind == TypeKind::WString ? 1 : (e.size ? e.size : 1);
+    // A WSTRING holds UTF-16 code units (as CODESYS and TwinCAT: WSTRING[N] takes 2*(N+1) bytes).
+    t->align = e.kind == TypeKind::String ? 1 : e.kind == TypeKind::WString ? 2 : (e.size ? e.size : 1);
     if (t->is_string()) t->str_len = 80;
     t->init.assign(t->size, 0);
     elementary_[static_cast<size_t>(e.kind)] = t.get();
@@ -96,8 +97,8 @@ const Type* TypeTable::string_type(uint32_t len, bool wide) {
   Type* t = make(wide ? TypeKind::WString : TypeKind::String,
                  std::string(wide ? "WSTRING[" : "STRING[") + std::to_string(len) + "]");
   t->str_len = len;
-  t->size = len + 1;
-  t->align = 1;
+  t->size = wide ? 2 * (len + 1) : len + 1;
+  t->align = wide ? 2 : 1;
   t->init.assign(t->size, 0);
   return t;
 }

@@ -4,13 +4,16 @@
 #include "natives.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
+#include <type_traits>
 
 #include <fmt/format.h>
 
 #include "memory.hpp"
 #include "vm.hpp"
+#include "wide.hpp"
 
 namespace plcfi::st {
 
@@ -60,59 +63,88 @@ MATH(ATAN, std::atan(x))
 MATH(EXPT, std::pow(x, y))
 #undef MATH
 
+// The string functions on STRING (Ch = char, bytes) and on WSTRING (Ch = char16_t,
+// UTF-16 code units): lengths and positions count the elements of the one or the other.
+template <class Ch>
+using Text = std::basic_string<Ch>;
+template <class Ch>
+Text<Ch> text(const uint8_t* p) {
+  if constexpr (std::is_same_v<Ch, char>) return reinterpret_cast<const char*>(p);
+  else return load_wstring(p, SIZE_MAX);
+}
+template <class Ch>
+void put_text(uint8_t* dst, uint32_t cap, const Text<Ch>& s) {
+  if constexpr (std::is_same_v<Ch, char>) put(dst, cap, s.data(), s.size());
+  else store_wstring(dst, cap, s);
+}
+
 // a: INT result, b: string
+template <class Ch>
 void s_len(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
-  store_as<int16_t>(a, static_cast<int16_t>(std::strlen(cs(b))));
+  store_as<int16_t>(a, static_cast<int16_t>(text<Ch>(b).size()));
 }
 // a := LEFT(b, L = c)
+template <class Ch>
 void s_left(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
-  std::string s = cs(b);
-  put(a, cap, s.substr(0, clamp_len(load_as<int64_t>(c), s.size())));
+  Text<Ch> s = text<Ch>(b);
+  put_text<Ch>(a, cap, s.substr(0, clamp_len(load_as<int64_t>(c), s.size())));
 }
+template <class Ch>
 void s_right(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
-  std::string s = cs(b);
+  Text<Ch> s = text<Ch>(b);
   auto n = clamp_len(load_as<int64_t>(c), s.size());
-  put(a, cap, s.substr(s.size() - n));
+  put_text<Ch>(a, cap, s.substr(s.size() - n));
 }
 // a := MID(b, L = c, P = d), P 1-based
+template <class Ch>
 void s_mid(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
-  std::string s = cs(b);
+  Text<Ch> s = text<Ch>(b);
   int64_t p = load_as<int64_t>(d);
-  if (p < 1 || static_cast<size_t>(p) > s.size()) return put(a, cap, "", 0);
-  put(a, cap, s.substr(p - 1, clamp_len(load_as<int64_t>(c), s.size())));
+  if (p < 1 || static_cast<size_t>(p) > s.size()) return put_text<Ch>(a, cap, Text<Ch>());
+  put_text<Ch>(a, cap, s.substr(p - 1, clamp_len(load_as<int64_t>(c), s.size())));
 }
+template <class Ch>
 void s_concat(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
-  put(a, cap, std::string(cs(b)) + cs(c));
+  put_text<Ch>(a, cap, text<Ch>(b) + text<Ch>(c));
 }
 // a := INSERT(IN1 = b, IN2 = c, P = d): IN2 inserted after the P-th character of IN1
+template <class Ch>
 void s_insert(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
-  std::string s = cs(b);
+  Text<Ch> s = text<Ch>(b);
   auto p = clamp_len(load_as<int64_t>(d), s.size());
-  s.insert(p, cs(c));
-  put(a, cap, s);
+  s.insert(p, text<Ch>(c));
+  put_text<Ch>(a, cap, s);
 }
 // a := DELETE(IN = b, L = c, P = d): L characters from position P
+template <class Ch>
 void s_delete(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
-  std::string s = cs(b);
+  Text<Ch> s = text<Ch>(b);
   int64_t p = load_as<int64_t>(d);
   if (p >= 1 && static_cast<size_t>(p) <= s.size()) s.erase(p - 1, clamp_len(load_as<int64_t>(c), s.size()));
-  put(a, cap, s);
+  put_text<Ch>(a, cap, s);
 }
 // a := REPLACE(IN1 = b, IN2 = c, L = d[0], P = d[1])
+template <class Ch>
 void s_replace(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
-  std::string s = cs(b);
+  Text<Ch> s = text<Ch>(b);
   int64_t l = load_as<int64_t>(d), p = load_as<int64_t>(d + 8);
   if (p < 1) p = 1;
   if (static_cast<size_t>(p) > s.size() + 1) p = static_cast<int64_t>(s.size()) + 1;
-  s.replace(p - 1, clamp_len(l, s.size()), cs(c));
-  put(a, cap, s);
+  s.replace(p - 1, clamp_len(l, s.size()), text<Ch>(c));
+  put_text<Ch>(a, cap, s);
 }
 // a: INT := FIND(IN1 = b, IN2 = c), 0 when not found
+template <class Ch>
 void s_find(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
-  std::string s = cs(b);
-  std::string t = cs(c);
-  auto pos = t.empty() ? std::string::npos : s.find(t);
-  store_as<int16_t>(a, pos == std::string::npos ? int16_t(0) : static_cast<int16_t>(pos + 1));
+  Text<Ch> s = text<Ch>(b);
+  Text<Ch> t = text<Ch>(c);
+  auto pos = t.empty() ? Text<Ch>::npos : s.find(t);
+  store_as<int16_t>(a, pos == Text<Ch>::npos ? int16_t(0) : static_cast<int16_t>(pos + 1));
+}
+// STRING_TO_WSTRING and back: a (capacity cap) := b, between UTF-8 and UTF-16.
+void s_to_w(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { store_wstring(a, cap, utf8_to_utf16(cs(b))); }
+void w_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
+  put(a, cap, utf16_to_utf8(load_wstring(b, SIZE_MAX)));
 }
 
 void i64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(load_as<int64_t>(b))); }
@@ -334,8 +366,13 @@ constexpr Entry kNatives[] = {
 #define X(n) {n##_F32, #n "_F32"}, {n##_F64, #n "_F64"},
     PLCFI_NATIVE_MATH(X)
 #undef X
-    {s_len, "LEN"}, {s_left, "LEFT"}, {s_right, "RIGHT"}, {s_mid, "MID"}, {s_concat, "CONCAT"},
-    {s_insert, "INSERT"}, {s_delete, "DELETE"}, {s_replace, "REPLACE"}, {s_find, "FIND"},
+    {s_len<char>, "LEN"}, {s_left<char>, "LEFT"}, {s_right<char>, "RIGHT"}, {s_mid<char>, "MID"},
+    {s_concat<char>, "CONCAT"}, {s_insert<char>, "INSERT"}, {s_delete<char>, "DELETE"},
+    {s_replace<char>, "REPLACE"}, {s_find<char>, "FIND"},
+    {s_len<char16_t>, "WLEN"}, {s_left<char16_t>, "WLEFT"}, {s_right<char16_t>, "WRIGHT"}, {s_mid<char16_t>, "WMID"},
+    {s_concat<char16_t>, "WCONCAT"}, {s_insert<char16_t>, "WINSERT"}, {s_delete<char16_t>, "WDELETE"},
+    {s_replace<char16_t>, "WREPLACE"}, {s_find<char16_t>, "WFIND"},
+    {s_to_w, "STRING_TO_WSTRING"}, {w_to_s, "WSTRING_TO_STRING"},
     {i64_to_s, "I64_TO_STRING"}, {u64_to_s, "U64_TO_STRING"}, {f32_to_s, "REAL_TO_STRING"},
     {f64_to_s, "LREAL_TO_STRING"}, {bool_to_s, "BOOL_TO_STRING"}, {time_to_s, "TIME_TO_STRING"},
     {date_to_s, "DATE_TO_STRING"}, {tod_to_s, "TOD_TO_STRING"}, {dt_to_s, "DT_TO_STRING"},

@@ -15,6 +15,9 @@ enum class Native : uint32_t {
   PLCFI_NATIVE_MATH(X)
 #undef X
   S_LEN, S_LEFT, S_RIGHT, S_MID, S_CONCAT, S_INSERT, S_DELETE, S_REPLACE, S_FIND,
+  // The same on WSTRINGs (UTF-16 code units), in the same order (wide_native()).
+  W_LEN, W_LEFT, W_RIGHT, W_MID, W_CONCAT, W_INSERT, W_DELETE, W_REPLACE, W_FIND,
+  S_TO_W, W_TO_S,  // a (capacity cap) := b, STRING (UTF-8) to WSTRING (UTF-16) and back
   I64_TO_S, U64_TO_S, F32_TO_S, F64_TO_S, BOOL_TO_S, TIME_TO_S, DATE_TO_S, TOD_TO_S, DT_TO_S,
   S_TO_I64, S_TO_U64, S_TO_F64, S_TO_BOOL, S_TO_TIME,
   DT_TO_DATE, DT_TO_TOD,
@@ -34,6 +37,11 @@ enum class Native : uint32_t {
   TCUNIT,
   Count_
 };
+
+// The WSTRING variant of a string function's native (S_LEN .. S_FIND).
+inline Native wide_native(Native n) {
+  return static_cast<Native>(static_cast<uint32_t>(n) + (static_cast<uint32_t>(Native::W_LEN) - static_cast<uint32_t>(Native::S_LEN)));
+}
 
 // Whether the native can trap (the NATIVE instruction then checks for it).
 inline bool native_traps(uint32_t id) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -137,6 +138,30 @@ inline T divk(T nv, uint64_t m, int32_t kv) {
   auto q = static_cast<int64_t>(static_cast<uint64_t>((static_cast<U128>(un) * m) >> 63));
   if ((n < 0) != (k < 0)) q = -q;
   return static_cast<T>(IsMod ? n - q * k : q);
+}
+
+// WSTRING: UTF-16 code units, ended by a 0 unit, at any address (memcpy, no aligned
+// 16-bit loads). The interpreter's WSCPY and WSCMP and the native tier's run these.
+inline uint16_t wunit(const uint8_t* p, size_t i) { return ld<uint16_t>(p + 2 * i); }
+// The code units before the terminator, at most cap.
+inline size_t wstrnlen(const uint8_t* p, size_t cap) {
+  size_t n = 0;
+  while (n < cap && wunit(p, n) != 0) ++n;
+  return n;
+}
+// dst (capacity cap units) := src, truncated; the two may overlap.
+inline void wscpy(uint8_t* dst, const uint8_t* src, size_t cap) {
+  size_t n = wstrnlen(src, cap);
+  std::memmove(dst, src, 2 * n);
+  st<uint16_t>(dst + 2 * n, 0);
+}
+// -1, 0 or 1 by the first differing code unit (unsigned), as strcmp does by bytes.
+inline int wscmp(const uint8_t* a, const uint8_t* b) {
+  for (size_t i = 0;; ++i) {
+    uint16_t x = wunit(a, i), y = wunit(b, i);
+    if (x != y) return x < y ? -1 : 1;
+    if (x == 0) return 0;
+  }
 }
 
 }  // namespace plcfi::st::ops

@@ -4,6 +4,7 @@
 #include "vm.hpp"
 #include "native/native.hpp"
 #include "natives.hpp"
+#include "wide.hpp"
 
 #include <bit>
 #include <cmath>
@@ -28,6 +29,19 @@ template <class T> inline bool jge(T a, T b) { return a >= b; }
 inline bool jnlt(float a, float b) { return !(a < b); }
 inline bool overlap(uint32_t a, uint32_t na, uint32_t b, uint32_t nb) {
   return static_cast<uint64_t>(a) < static_cast<uint64_t>(b) + nb && static_cast<uint64_t>(b) < static_cast<uint64_t>(a) + na;
+}
+
+// SCMP and WSCMP: whether compare() result c satisfies relation rel (0 =, 1 <>, 2 <,
+// 3 <=, 4 >, 5 >=).
+inline bool relation_holds(int c, uint32_t rel) {
+  switch (rel) {
+    case 0: return c == 0;
+    case 1: return c != 0;
+    case 2: return c < 0;
+    case 3: return c <= 0;
+    case 4: return c > 0;
+    default: return c >= 0;
+  }
 }
 
 constexpr OpInfo kOps[] = {
@@ -547,20 +561,11 @@ L_SCPY: {
   base[pc[1] + n] = 0;
   NEXT(3);
 }
-L_SCMP: {
-  int c = std::strcmp(reinterpret_cast<const char*>(base + pc[2]), reinterpret_cast<const char*>(base + pc[3]));
-  bool r = false;
-  switch (pc[4]) {
-    case 0: r = c == 0; break;
-    case 1: r = c != 0; break;
-    case 2: r = c < 0; break;
-    case 3: r = c <= 0; break;
-    case 4: r = c > 0; break;
-    default: r = c >= 0; break;
-  }
-  W(uint8_t, 1, r);
+L_SCMP:
+  W(uint8_t, 1, relation_holds(std::strcmp(reinterpret_cast<const char*>(base + pc[2]), reinterpret_cast<const char*>(base + pc[3])), pc[4]));
   NEXT(4);
-}
+L_WSCPY: ops::wscpy(base + pc[1], base + pc[2], pc[3]); NEXT(3);
+L_WSCMP: W(uint8_t, 1, relation_holds(ops::wscmp(base + pc[2], base + pc[3]), pc[4])); NEXT(4);
 L_GETBIT1: W(uint8_t, 1, static_cast<uint8_t>((R(uint8_t, 2) >> pc[3]) & 1u)); NEXT(3);
 L_GETBIT2: W(uint8_t, 1, static_cast<uint8_t>((R(uint16_t, 2) >> pc[3]) & 1u)); NEXT(3);
 L_GETBIT4: W(uint8_t, 1, static_cast<uint8_t>((R(uint32_t, 2) >> pc[3]) & 1u)); NEXT(3);
@@ -909,6 +914,7 @@ std::string format_value(ValueKind k, const uint8_t* p) {
     case ValueKind::Tod: return tod_literal(ld<int64_t>(p));
     case ValueKind::Dt: return dt_literal(ld<int64_t>(p));
     case ValueKind::String: return "'" + std::string(reinterpret_cast<const char*>(p)) + "'";
+    case ValueKind::WString: return "'" + utf16_to_utf8(load_wstring(p, SIZE_MAX)) + "'";  // shown as UTF-8
   }
   return "?";
 }
@@ -936,6 +942,7 @@ int compare(ValueKind k, const uint8_t* a, const uint8_t* b) {
       int c = std::strcmp(reinterpret_cast<const char*>(a), reinterpret_cast<const char*>(b));
       return c < 0 ? -1 : (c > 0 ? 1 : 0);
     }
+    case ValueKind::WString: return wscmp(a, b);
   }
   return 0;
 }

@@ -61,7 +61,7 @@ const char* native_name(uint32_t id);
 
 // Value kinds named in ASSERT instructions so failures print readable values.
 // UTime: CODESYS's unsigned LTIME.
-enum class ValueKind : uint8_t { Bool, I8, I16, I32, I64, U8, U16, U32, U64, F32, F64, Time, Date, Tod, Dt, String, Enum, Ref, UTime };
+enum class ValueKind : uint8_t { Bool, I8, I16, I32, I64, U8, U16, U32, U64, F32, F64, Time, Date, Tod, Dt, String, Enum, Ref, UTime, WString };
 enum class AssertKind : uint8_t { Eq, Neq, True, False, Gt, Lt, Ge, Le, Near, Called, CallCount };
 
 class Machine;
