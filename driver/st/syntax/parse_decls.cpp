@@ -455,6 +455,9 @@ void Parser::parse_pou_body(Pou& pou, bool allow_members) {
     } else if (at(Tok::Eof) || is_unit_end(cur().kind) || is_top_level_start(cur().kind) || at(Tok::Resource) ||
                at_test_block_start()) {
       return;
+    } else if (!seen_statements && pou.has_body && pou.kind != PouKind::Interface && at_il_body()) {
+      parse_il_body(pou);
+      seen_statements = true;
     } else {
       const size_t first = pou.body.size();
       parse_stmt_list(pou.body, false);

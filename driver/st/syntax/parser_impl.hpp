@@ -302,6 +302,14 @@ class Parser {
   TaskDecl parse_task();
   ProgramInstDecl parse_program_inst();
 
+  // ------------------------------------------------------------ Instruction List (parse_il.cpp)
+  // The body's first line is an IL instruction: the statements are IL, up to the POU's end.
+  bool at_il_body() const;
+  bool il_line_at(size_t i, bool formal_call) const;
+  bool formal_call_line(size_t open) const;
+  void parse_il_body(Pou& pou);
+  friend class IlReader;
+
   // ------------------------------------------------------------ test files (parse_tests.cpp)
   StmtPtr parse_mock();
   StmtPtr parse_mock_function();
