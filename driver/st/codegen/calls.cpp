@@ -105,7 +105,11 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
         Val r = call_fb(p, s->type->pou, c);
         return r;
       }
-      diags_.error("ST213", callee.loc, "'" + n.name.text + "' is a " + s->type->name + " variable, not callable");
+      if (c.il_operator)
+        diags_.error("ST245", callee.loc, "'" + n.name.text + "' is a " + s->type->name + " variable, not an IL operator "
+                                          "(to load it: LD " + n.name.text + ")");
+      else
+        diags_.error("ST213", callee.loc, "'" + n.name.text + "' is a " + s->type->name + " variable, not callable");
       return bad();
     }
     auto it = pous_.find(key);
@@ -146,6 +150,11 @@ Val Compiler::call(const CallExpr& c, bool as_statement) {
              ((f && f->codesys_only()) || std::any_of(tc2_system_items().begin(), tc2_system_items().end(),
                                                       [&](const Tc2Item& t) { return iequals(t.name, key); })))
       why = " (a function of TwinCAT's Tc2_System: --dialect codesys)";
+    if (c.il_operator) {
+      diags_.error("ST245", callee.loc, "unknown IL operator '" + n.name.text + "': neither an operator of Instruction List "
+                                        "(LD, ST, S, R, AND, OR, XOR, NOT, ADD, ..., JMP, CAL, RET) nor a function" + why);
+      return bad();
+    }
     diags_.error("ST211", callee.loc, "unknown function '" + n.name.text + "'" + why);
     return bad();
   }

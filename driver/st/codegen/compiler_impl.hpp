@@ -151,6 +151,10 @@ struct Body {
   };
   std::vector<Loop> loops;
   uint32_t arm = kNoBranch;  // the branch id whose arm is being compiled (coverage nesting)
+  // JMP targets: the labels of the outermost statement list being compiled (canon name ->
+  // label, where declared), and how deep in statement lists the compiler is (1: outermost).
+  std::unordered_map<std::string, std::pair<Label, SourceLoc>> goto_labels;
+  int stmt_depth = 0;
   std::vector<std::unique_ptr<Symbol>> owned;  // This-symbols made for methods
   // Monitors: state of temporal operators (current and previous value of each argument).
   uint32_t hidden_size = 0;
@@ -275,6 +279,11 @@ class Compiler {
   void for_stmt(const ForStmt& s);
   void while_stmt(const WhileStmt& s);
   void repeat_stmt(const RepeatStmt& s);
+  // Labels and JMP (Instruction List, CODESYS ST); the current-result variables IL declares.
+  void declare_labels(const StmtList& list);
+  void label_stmt(const LabelStmt& s);
+  void jump_stmt(const JumpStmt& s);
+  void declare_temp(const AssignStmt& s);
   // A coverage id for an arm (BranchPoint): `decision` holds the statement's first arm id
   // (kNoBranch before it); the arm's body is to be compiled inside an ArmScope.
   uint32_t branch(SourceLoc loc, const char* kind, SourceLoc stmt, uint32_t* decision, const StmtList& body);

@@ -190,6 +190,8 @@ Place Compiler::place_ref(const Expr& e, bool for_write) {
                                               : std::string()));
         return bad_place;
       }
+      // An IL current-result variable whose declaration failed: that error was reported.
+      if (n.name.text.rfind("__IL_CR", 0) == 0) return bad_place;
       diags_.error("ST200", e.loc, "unknown identifier '" + n.name.text + "'");
       return bad_place;
     }

@@ -112,16 +112,110 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
   emit(when_true ? Op::JMPT : Op::JMPF, {Arg::target(target.id), cs});
 }
 
+namespace {
+struct DepthScope {
+  int& depth;
+  explicit DepthScope(int& d) : depth(d) { ++depth; }
+  ~DepthScope() { --depth; }
+  DepthScope(const DepthScope&) = delete;
+  DepthScope& operator=(const DepthScope&) = delete;
+};
+}  // namespace
+
 void Compiler::stmts(const StmtList& list) {
+  DepthScope depth(b_->stmt_depth);
+  if (b_->stmt_depth == 1) declare_labels(list);
   bool dead = false;
   for (const auto& s : list) {
+    if (s->kind == StmtKind::Label) dead = false;  // a jump may reach it
     if (dead && opt_.warnings && s->kind != StmtKind::Empty && !(b_->pou && b_->pou->is_stdlib)) {
       diags_.warning("ST402", s->loc, "unreachable statement");
       dead = false;  // once per list
     }
     stmt(*s);
-    if (s->kind == StmtKind::Return || s->kind == StmtKind::Exit || s->kind == StmtKind::Continue) dead = true;
+    if (s->kind == StmtKind::Return || s->kind == StmtKind::Exit || s->kind == StmtKind::Continue ||
+        s->kind == StmtKind::Jump)
+      dead = true;
   }
+}
+
+// The labels of an outermost statement list, known before its first JMP (a jump forward).
+void Compiler::declare_labels(const StmtList& list) {
+  b_->goto_labels.clear();
+  for (const auto& s : list) {
+    if (s->kind != StmtKind::Label) continue;
+    const auto& l = static_cast<const LabelStmt&>(*s);
+    auto [it, fresh] = b_->goto_labels.try_emplace(canon(l.name.text), std::pair{new_label(), l.name.loc});
+    if (!fresh) {
+      const SourceLoc first = it->second.second;
+      diags_.error("ST244", l.name.loc, "label '" + l.name.text + "' is declared twice (first at line " +
+                                            std::to_string(first.line) + ")");
+    }
+  }
+}
+
+void Compiler::label_stmt(const LabelStmt& s) {
+  if (!s.from_il && opt_.dialect == Dialect::Iec) {
+    diags_.error("ST241", s.loc, "a label (" + s.name.text + ":) is CODESYS ST, not IEC 61131-3: use IF, CASE or a loop, or --dialect codesys");
+    return;
+  }
+  auto it = b_->goto_labels.find(canon(s.name.text));
+  if (b_->stmt_depth != 1 || it == b_->goto_labels.end()) {
+    diags_.error("ST244", s.name.loc, "label '" + s.name.text +
+                                          "' must stand at the outer level of the body, not inside IF, CASE or a loop (a jump may leave a block, not enter one)");
+    return;
+  }
+  // A label declared twice binds where it was first declared (the second is reported).
+  if (it->second.second.line == s.name.loc.line && it->second.second.col == s.name.loc.col) bind(it->second.first);
+}
+
+void Compiler::jump_stmt(const JumpStmt& s) {
+  if (!s.from_il && opt_.dialect == Dialect::Iec) {
+    diags_.error("ST241", s.loc, "JMP is CODESYS ST, not IEC 61131-3: use IF, CASE or a loop, or --dialect codesys");
+    return;
+  }
+  auto it = b_->goto_labels.find(canon(s.label.text));
+  if (it == b_->goto_labels.end()) {
+    diags_.error("ST244", s.label.loc, "JMP to '" + s.label.text + "', a label the body does not have");
+    return;
+  }
+  const Label target = it->second.first;
+  // A jump back to a label already placed is a loop: it counts against the watchdog.
+  emit(b_->label_pos[target.id] == UINT32_MAX ? Op::JMP : Op::JMPB, {Arg::target(target.id)});
+}
+
+// `__IL_CRn := e` from Instruction List: a variable of this body, typed by e, in the
+// hidden area of the frame (never reused, so it survives the statements and jumps that
+// follow; names with two underscores cannot clash with the program's own).
+void Compiler::declare_temp(const AssignStmt& s) {
+  const auto& name = static_cast<const NameExpr&>(*s.lhs).name;
+  if (s.rhs->kind == ExprKind::Call) {
+    const PouInfo* f = callee_pou(*static_cast<const CallExpr&>(*s.rhs).callee);
+    if (f && f->kind == PouKind::Function && f->result && f->result->kind == TypeKind::Void) {
+      call(static_cast<const CallExpr&>(*s.rhs), true);  // a function without a result: a call
+      return;
+    }
+  }
+  Val v = expr(*s.rhs);
+  if (!v.ok) return;
+  const Type* t = v.type ? v.type : default_type(v.c);
+  const Slot at = hidden(t->size ? t->size : 1, t->align < 8 ? t->align : 8);
+  auto sym = std::make_unique<Symbol>();
+  sym->name = name.text;
+  sym->type = t;
+  sym->where = Where::Frame;
+  sym->offset = align_up(b_->vars_end, 8) + at.off;
+  sym->section = VarSection::Temp;
+  sym->loc = name.loc;
+  b_->locals[canon(name.text)] = sym.get();
+  const Symbol* declared = sym.get();
+  b_->owned.push_back(std::move(sym));
+  Place dst;
+  dst.k = Place::K::Frame;
+  dst.type = t;
+  dst.off = declared->offset;
+  dst.sym = declared;
+  assign(dst, v, s.loc);
 }
 
 void Compiler::stmt(const Stmt& s) {
@@ -148,6 +242,8 @@ void Compiler::stmt(const Stmt& s) {
       break;
     case StmtKind::Return: emit(Op::RET, {}); break;
     case StmtKind::Empty: break;
+    case StmtKind::Label: label_stmt(static_cast<const LabelStmt&>(s)); break;
+    case StmtKind::Jump: jump_stmt(static_cast<const JumpStmt&>(s)); break;
     case StmtKind::Mock: {
       const auto& m = static_cast<const MockStmt&>(s);
       if (!b_->in_test) {
@@ -235,6 +331,7 @@ void Compiler::assign_stmt(const AssignStmt& s) {
     return;
   }
   if (s.rhs->kind == ExprKind::Call && enabled_call(static_cast<const CallExpr&>(*s.rhs), &s)) return;
+  if (s.declares_temp) return declare_temp(s);
   // Warn about x := x, a typing accident more often than intent.
   if (opt_.warnings && s.lhs->kind == ExprKind::Name && s.rhs->kind == ExprKind::Name &&
       iequals(static_cast<const NameExpr&>(*s.lhs).name.text, static_cast<const NameExpr&>(*s.rhs).name.text))

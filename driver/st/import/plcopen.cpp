@@ -564,13 +564,16 @@ class Importer {
   bool body(const pugi::xml_node& owner, const std::string& what) {
     pugi::xml_node b = child(owner, "body");
     if (!b) return true;
-    if (pugi::xml_node st = child(b, "ST")) {
-      Copy c;
-      gather_text(st, &c, 0);
-      if (!c.text.empty()) copy("", c, "");
-      return true;
-    }
-    for (const char* lang : {"LD", "FBD", "SFC", "IL"})
+    // ST and IL bodies are text the front end reads (it tells IL by its first line), each
+    // line located at its place in the XML.
+    for (const char* lang : {"ST", "IL"})
+      if (pugi::xml_node text = child(b, lang)) {
+        Copy c;
+        gather_text(text, &c, 0);
+        if (!c.text.empty()) copy("", c, "");
+        return true;
+      }
+    for (const char* lang : {"LD", "FBD", "SFC"})
       if (child(b, lang)) {
         // The POU stays, with an empty body: its interface is sound, so its users compile.
         diags_.error("ST604", loc(b), what + " has an " + std::string(lang) + " body: plcfi runs ST bodies only");

@@ -138,6 +138,9 @@ struct CallExpr : Expr {
   explicit CallExpr(SourceLoc l) : Expr(ExprKind::Call, l) {}
   ExprPtr callee;  // Name (function, FB instance, program instance) or Member (method, nested FB)
   std::vector<CallArg> args;
+  // Instruction List: the callee was written as an operator (`LD a  MYFUN b`), so a name
+  // that is no function is an unknown IL operator rather than an unknown function.
+  bool il_operator = false;
 };
 
 struct UnaryExpr : Expr {
@@ -274,6 +277,8 @@ enum class StmtKind {
   Empty,      // ;
   Mock,       // test files: MOCK path;
   MockFunction,  // test files: MOCK_FUNCTION Name RETURNS expr;
+  Label,      // name:   (a jump target: Instruction List, and CODESYS ST)
+  Jump,       // JMP name;
 };
 
 struct Stmt {
@@ -291,6 +296,10 @@ struct AssignStmt : Stmt {
   bool is_ref_assign = false;  // REF=
   char set_reset = 0;          // 'S' for S= (CODESYS: lhs := TRUE when rhs), 'R' for R= (lhs := FALSE)
   bool chained = false;        // `b := c` of `a := b := c` (CODESYS), split into `b := c; a := b;`
+  // Instruction List: lhs is a Name the body has not declared, a hidden variable that this
+  // assignment declares with the type of rhs (the current result kept for later
+  // instructions; only the compiler knows its type).
+  bool declares_temp = false;
 };
 
 struct CallStmt : Stmt {
@@ -360,6 +369,20 @@ struct MockFunctionStmt : Stmt {
   explicit MockFunctionStmt(SourceLoc l) : Stmt(StmtKind::MockFunction, l) {}
   Ident function;
   ExprPtr value;
+};
+
+// `name:` and `JMP name;`. Labels belong to the outermost statement list of a body; a jump
+// may leave blocks but not enter one.
+struct LabelStmt : Stmt {
+  explicit LabelStmt(SourceLoc l) : Stmt(StmtKind::Label, l) {}
+  Ident name;
+  bool from_il = false;  // written in Instruction List (IEC), not ST (CODESYS only)
+};
+
+struct JumpStmt : Stmt {
+  explicit JumpStmt(SourceLoc l) : Stmt(StmtKind::Jump, l) {}
+  Ident label;
+  bool from_il = false;
 };
 
 // ---------------------------------------------------------------- SFC

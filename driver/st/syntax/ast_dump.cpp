@@ -116,7 +116,7 @@ std::string dump(const Stmt& s) {
   switch (s.kind) {
     case StmtKind::Assign: {
       const auto& x = static_cast<const AssignStmt&>(s);
-      return std::string("(") + (x.is_ref_assign ? "REF=" : x.set_reset == 'S' ? "S=" : x.set_reset == 'R' ? "R=" : ":=") + " " + opt(x.lhs) + " " + opt(x.rhs) + ")";
+      return std::string("(") + (x.declares_temp ? "let" : x.is_ref_assign ? "REF=" : x.set_reset == 'S' ? "S=" : x.set_reset == 'R' ? "R=" : ":=") + " " + opt(x.lhs) + " " + opt(x.rhs) + ")";
     }
     case StmtKind::Call: {
       const auto& x = static_cast<const CallStmt&>(s);
@@ -166,6 +166,8 @@ std::string dump(const Stmt& s) {
       const auto& x = static_cast<const MockFunctionStmt&>(s);
       return "(mock_function " + x.function.text + " " + opt(x.value) + ")";
     }
+    case StmtKind::Label: return "(label " + static_cast<const LabelStmt&>(s).name.text + ")";
+    case StmtKind::Jump: return "(jmp " + static_cast<const JumpStmt&>(s).label.text + ")";
   }
   return "?";
 }

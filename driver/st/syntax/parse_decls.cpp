@@ -448,6 +448,9 @@ void Parser::parse_pou_body(Pou& pou, bool allow_members) {
     } else if (at_sfc_start()) {
       parse_sfc_element(pou);
       seen_statements = true;
+    } else if (!seen_statements && pou.has_body && pou.kind != PouKind::Interface && at_il_body()) {
+      parse_il_body(pou);
+      seen_statements = true;
     } else {
       const size_t first = pou.body.size();
       parse_stmt_list(pou.body, false);

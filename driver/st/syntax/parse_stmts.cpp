@@ -85,6 +85,21 @@ StmtPtr Parser::parse_statement() {
       if (test_mode_ && iequals(t.text, "MOCK") && (la(1).kind == Tok::Ident || la(1).kind == Tok::This))
         return parse_mock();
       if (test_mode_ && iequals(t.text, "MOCK_FUNCTION") && la(1).kind == Tok::Ident) return parse_mock_function();
+      // CODESYS ST: `JMP label;` and `label:` (the compiler rejects them under --dialect iec).
+      if (iequals(t.text, "JMP") && la(1).kind == Tok::Ident && la(2).kind == Tok::Semi) {
+        advance();
+        auto j = std::make_unique<JumpStmt>(t.loc);
+        j->label = Ident{std::string(advance().text), prev().loc};
+        advance();  // ';'
+        return j;
+      }
+      if (la(1).kind == Tok::Colon) {
+        auto l = std::make_unique<LabelStmt>(t.loc);
+        l->name = Ident{std::string(t.text), t.loc};
+        advance();
+        advance();  // ':'
+        return l;
+      }
       return parse_assign_or_call();
     case Tok::This: case Tok::Super: case Tok::DirectAddr:
       return parse_assign_or_call();

@@ -326,6 +326,13 @@ class Parser {
   void parse_sfc_action(SfcChart& chart);
   void expect_sfc_end(std::string_view end, const std::string& what, SourceLoc open_loc);
   bool in_sfc_action_ = false;
+  // ------------------------------------------------------------ Instruction List (parse_il.cpp)
+  // The body's first line is an IL instruction: the statements are IL, up to the POU's end.
+  bool at_il_body() const;
+  bool il_line_at(size_t i, bool formal_call) const;
+  bool formal_call_line(size_t open) const;
+  void parse_il_body(Pou& pou);
+  friend class IlReader;
 
   // ------------------------------------------------------------ test files (parse_tests.cpp)
   StmtPtr parse_mock();

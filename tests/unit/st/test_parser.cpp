@@ -986,5 +986,37 @@ TEST(ParserRobustness, PathologicalInputs) {
   parse_both(nul);
 }
 
+// ------------------------------------------------------------------ Instruction List
+
+// The lowering of IL to ST statements: the current result stays an expression until a
+// write could change what it reads and a later instruction still reads it; a function
+// call is kept at once (`let`: a hidden variable typed by the compiler).
+TEST(ParserIl, LowersToStStatements) {
+  EXPECT_EQ(body("  LD a\n  ADD b\n  ST c"), "((:= c (+ a b)))");
+  EXPECT_EQ(body("  LDN a\n  ANDN b\n  STN c"), "((:= c (NOT (AND (NOT a) (NOT b)))))");
+  EXPECT_EQ(body("  LD a\n  ST b\n  ST c"), "((let __IL_CR1 a) (:= b __IL_CR1) (:= c __IL_CR1))");
+  EXPECT_EQ(body("  LD a\n  S q\n  LD b\n  R q"), "((if a ((:= q TRUE))) (if b ((:= q FALSE))))");
+  EXPECT_EQ(body("  LD a\n  AND( b\n  OR c\n  )\n  ST d"), "((:= d (AND a (OR b c))))");
+  EXPECT_EQ(body("  LD a\n  F b, 2\n  ST c"), "((let __IL_CR1 (call F a b 2)) (:= c __IL_CR1))");
+  EXPECT_EQ(body("  LD a\n  JMPCN l\n  CAL t(IN := a)\nl: RET"),
+            "((if (NOT a) ((jmp l))) (call t (IN := a)) (label l) RETURN)");
+  EXPECT_EQ(body("  LD x\n  IN t\n  CAL t"), "((:= (. t IN) x) (call t))");
+}
+
+// Bodies that begin with a name of an IL operator but are ST stay ST.
+TEST(ParserIl, StBodiesStaySt) {
+  EXPECT_EQ(body("LD := 1;"), "((:= LD 1))");
+  EXPECT_EQ(body("ST(x);"), "((call ST x))");
+  EXPECT_EQ(body("JMP done;\ndone:\nx := 1;"), "((jmp done) (label done) (:= x 1))");
+  EXPECT_EQ(body("S.x := 2;"), "((:= (. S x) 2))");
+}
+
+TEST(ParserIl, Errors) {
+  EXPECT_EQ(unit("PROGRAM p\n  LD a\n  ST\nEND_PROGRAM")->errors(), (Errors{{"ST136", 3}}));
+  EXPECT_EQ(unit("PROGRAM p\n  LD a\n  ADD( b\nEND_PROGRAM")->errors(), (Errors{{"ST137", 3}}));
+  EXPECT_EQ(unit("PROGRAM p\n  CAL t\n  ST a\nEND_PROGRAM")->errors(), (Errors{{"ST138", 3}}));
+  EXPECT_EQ(unit("PROGRAM p\n  LD a\n  42\nEND_PROGRAM")->errors(), (Errors{{"ST135", 3}}));
+}
+
 }  // namespace
 }  // namespace plcfi::st
