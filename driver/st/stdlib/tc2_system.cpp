@@ -96,6 +96,10 @@ const char* unprovided_library(std::string_view name) {
       {"FB_BufferedTextFile", "Tc2_Utilities"}, {"FB_EnumFindFileList", "Tc2_Utilities"},
       {"FB_MemBufferMerge", "Tc2_Utilities"}, {"FB_StringRingBuffer", "Tc2_Utilities"},
       {"F_FormatArgToStr", "Tc2_Utilities"}, {"SYSTEMTIME_TO_STRING", "Tc2_Utilities"},
+      // Beremiz's blocks that run Python in the runtime: no IEC code to run.
+      {"python_eval", "Beremiz's Python extension (it runs Python code in the runtime)"},
+      {"python_poll", "Beremiz's Python extension (it runs Python code in the runtime)"},
+      {"python_gear", "Beremiz's Python extension (it runs Python code in the runtime)"},
       {"MC_Power", "Tc2_MC2"}, {"MC_Reset", "Tc2_MC2"}, {"MC_Home", "Tc2_MC2"}, {"MC_Stop", "Tc2_MC2"},
       {"MC_Halt", "Tc2_MC2"}, {"MC_MoveAbsolute", "Tc2_MC2"}, {"MC_MoveRelative", "Tc2_MC2"},
       {"MC_MoveVelocity", "Tc2_MC2"}, {"MC_ReadStatus", "Tc2_MC2"}, {"AXIS_REF", "Tc2_MC2"},

@@ -159,6 +159,15 @@ void Lexer::skip_trivia() {
                                           : "unterminated comment: '/*' has no matching '*/'");
         pos_ = text_.size();
       }
+    } else if (c == '{' && peek(1) == '{') {
+      // Beremiz runs C written between {{ and }} in an ST body; plcfi cannot, and ignoring
+      // it like a pragma would run a different program.
+      const size_t begin = pos_;
+      const size_t close = text_.find("}}", pos_ + 2);
+      junk_ = true;
+      error("ST014", begin, "inline C code ({{ ... }}) is a Beremiz extension: plcfi runs IEC 61131-3 code, not C; "
+                            "write this part in ST");
+      pos_ = close == std::string_view::npos ? text_.size() : close + 2;
     } else if (c == '{') {
       const size_t begin = pos_;
       const size_t close = text_.find('}', pos_);
