@@ -123,6 +123,8 @@ class Translator {
         e.inputs.push_back(Input{"", false, connections(in), ""});
       }
       if (kind == "connector") connectors_[trimmed(n.attribute("name").value())] = e.id;
+      for (const auto& in : e.inputs)
+        for (const auto& c : in.from) read_.insert(c.ref);
       if (!by_id_.emplace(e.id, elements_.size()).second) return fail(n, "localId " + std::to_string(e.id) + " is used twice");
       elements_.push_back(std::move(e));
     }
@@ -454,10 +456,14 @@ class Translator {
   bool block(const Element& e) {
     if (type_of(e).empty()) return fail(e.n, "<block> has no typeName");
     const std::string inst = inst_of(e);
-    if (inst.empty()) return true;
+    if (inst.empty() && read_.count(e.id)) return true;  // a value, written where it is read
     std::string en, args;
     if (!enable(e, &en) || !arguments(e, true, &args)) return false;
     flush_pending(e);
+    if (inst.empty()) {  // a function nobody reads still runs (its in-out parameters, its effects)
+      line(type_of(e) + "(" + (en.empty() ? args : "EN := " + en + (args.empty() ? "" : ", " + args)) + ");", e);
+      return true;
+    }
     if (en.empty()) {
       line(inst + "(" + args + ");", e);
       if (enos_.count(e.id)) line("_ldeno" + std::to_string(e.id) + " := TRUE;", e);
@@ -480,6 +486,7 @@ class Translator {
   std::map<long, size_t> by_id_;
   std::map<std::string, long> connectors_;
   std::vector<long> temps_;
+  std::set<long> read_;                                        // elements some input is connected to
   std::set<long> enos_;                                        // blocks whose ENO is read
   std::vector<std::pair<std::string, std::string>> edge_inputs_;  // edge-sensing inputs: name, type
   std::vector<std::string> pending_;                           // their calls, before the next statement

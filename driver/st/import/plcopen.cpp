@@ -576,12 +576,14 @@ class Importer {
     for (const char* lang : {"LD", "FBD", "SFC"})
       if (child(b, lang)) {
         // The POU stays, with an empty body: its interface is sound, so its users compile.
-        diags_.error("ST604", loc(b), what + " has an " + std::string(lang) + " body: plcfi runs ST bodies only");
+        diags_.error("ST604", loc(b), what + " has an " + std::string(lang) + " body: plcfi reads LD, FBD and SFC bodies "
+                                      "of POUs, not of methods, actions or property accessors (write this one in ST or IL)");
         ok_ = false;
         return false;
       }
     if (pugi::xml_node other = first_element(b); other && !is(other, "addData") && !is(other, "documentation")) {
-      diags_.error("ST604", loc(b), what + " has a body in <" + std::string(local_name(other)) + ">: plcfi runs ST bodies only");
+      diags_.error("ST604", loc(b), what + " has a body in <" + std::string(local_name(other)) +
+                                        ">: plcfi reads ST, IL, LD, FBD and SFC bodies");
       ok_ = false;
       return false;
     }

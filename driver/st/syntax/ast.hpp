@@ -411,6 +411,7 @@ struct SfcTransition {
   std::optional<int64_t> priority;  // (PRIORITY := n): lower numbers are tried first
   std::vector<Ident> from, to;
   ExprPtr condition;                // moved out by the lowering
+  StmtList condition_body;          // a condition in IL: its statements, which set `condition` (a name)
   SourceLoc loc;
 };
 

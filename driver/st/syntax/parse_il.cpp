@@ -270,6 +270,10 @@ class IlReader {
  public:
   IlReader(Parser& p, Pou& pou) : p_(p), pou_(pou) {}
 
+  // An SFC transition condition in IL: its value is the current result at the end, which
+  // lower_all stores into `var` (a BOOL the chart declares).
+  void result_into(std::string var) { result_ = std::move(var); }
+
   void run() {
     while (!p_.at_terminator()) {
       const size_t before = p_.pos_;
@@ -466,7 +470,20 @@ class IlReader {
 
   void lower_all() {
     for (size_t i = 0; i < instrs_.size(); ++i) lower(i);
-    discard_cr(instrs_.empty() ? pou_.loc : instrs_.back().loc);
+    const SourceLoc end = instrs_.empty() ? pou_.loc : instrs_.back().loc;
+    if (result_.empty()) {
+      discard_cr(end);
+    } else if (!cr_) {
+      p_.diags_.error("ST138", end, "the transition condition ends without a current result (undefined " + undefined_ +
+                                        "): its last instruction must leave the condition's value, e.g. LD x");
+    } else {
+      auto s = std::make_unique<AssignStmt>(end);
+      auto n = std::make_unique<NameExpr>(end);
+      n->name = Ident{result_, end};
+      s->lhs = std::move(n);
+      s->rhs = std::move(cr_);
+      emit(std::move(s));
+    }
     for (const auto& p : parens_)
       p_.diags_.error("ST137", p.loc, "'" + p.spelling + "' is never closed: ')' is missing before the end of the body");
   }
@@ -747,6 +764,7 @@ class IlReader {
   std::vector<Instr> instrs_;
   ExprPtr cr_;  // null: undefined
   std::string undefined_ = "at the start of the body: load a value with LD first";
+  std::string result_;  // see result_into
   bool consumed_ = false;  // an instruction has read cr_
   int depth_ = 0;          // operators cr_ holds since it was loaded or kept
   std::vector<Paren> parens_;
@@ -807,5 +825,11 @@ bool Parser::formal_call_line(size_t open) const {
 }
 
 void Parser::parse_il_body(Pou& pou) { IlReader(*this, pou).run(); }
+
+void Parser::parse_il_into(Pou& holder, const std::string& result_var) {
+  IlReader r(*this, holder);
+  if (!result_var.empty()) r.result_into(result_var);
+  r.run();
+}
 
 }  // namespace plcfi::st::detail

@@ -3,9 +3,10 @@
 //   INITIAL_STEP name ':' {association ';'} END_STEP
 //   STEP name ':' {association ';'} END_STEP
 //   association := action '(' [qualifier [',' duration]] {',' indicator} ')'
-//   TRANSITION [name] ['(' PRIORITY ':=' integer ')'] FROM steps TO steps ':=' expr ';' END_TRANSITION
+//   TRANSITION [name] ['(' PRIORITY ':=' integer ')'] FROM steps TO steps
+//     (':=' expr ';' | ':' IL instructions) END_TRANSITION
 //   steps := name | '(' name {',' name} ')'
-//   ACTION name ':' stmt_list END_ACTION
+//   ACTION name ':' (stmt_list | IL instructions) END_ACTION
 //
 // The words are not reserved in ST: they are recognised by what follows them. The chart
 // is lowered into ST when its POU ends (sfc_lower.hpp).
@@ -185,9 +186,24 @@ void Parser::parse_sfc_transition(SfcChart& chart) {
   if (ok && accept(Tok::Assign)) {
     t.condition = parse_expr();
     expect_semi("the transition condition");
-  } else if (ok && at(Tok::Colon)) {
-    error("ST140", cur().loc, what + ": a condition written as a statement list after ':' (IL, LD or FBD) is not "
-                                     "supported; write it as ':= expression;'");
+  } else if (ok && accept(Tok::Colon)) {
+    // The condition in IL: its final current result, kept in a BOOL of the chart.
+    const std::string var = "__sfc_c" + std::to_string(chart.transitions.size());
+    if (!at_il_body()) {
+      error("ST140", cur().loc, what + ": after ':' the condition is Instruction List (e.g. LD x  AND y), found " +
+                                    describe(cur()) + "; an ST condition is written ':= expression;'");
+    } else {
+      Pou holder;
+      holder.loc = cur().loc;
+      const std::string_view outer = sfc_end_;
+      sfc_end_ = "END_TRANSITION";
+      parse_il_into(holder, var);
+      sfc_end_ = outer;
+      t.condition_body = std::move(holder.body);
+      auto n = std::make_unique<NameExpr>(t.loc);
+      n->name = Ident{var, t.loc};
+      t.condition = std::move(n);
+    }
   } else if (ok) {
     error("ST140", missing_loc(), "expected ':=' and the condition of " + what + ", found " + describe(cur()));
   }
@@ -206,10 +222,17 @@ void Parser::parse_sfc_action(SfcChart& chart) {
   expect_ident(&a.name, "ST140", "an action name after ACTION");
   expect(Tok::Colon, "ST140", "after the action name");
   {
-    const bool outer = in_sfc_action_;
-    in_sfc_action_ = true;
-    parse_stmt_list(a.body, false);
-    in_sfc_action_ = outer;
+    const std::string_view outer = sfc_end_;
+    sfc_end_ = "END_ACTION";
+    if (at_il_body()) {  // an action body in Instruction List
+      Pou holder;
+      holder.loc = a.loc;
+      parse_il_into(holder, "");
+      a.body = std::move(holder.body);
+    } else {
+      parse_stmt_list(a.body, false);
+    }
+    sfc_end_ = outer;
   }
   expect_sfc_end("END_ACTION", "ACTION '" + a.name.text + "'", kw.loc);
   chart.actions.push_back(std::move(a));

@@ -223,7 +223,7 @@ class Parser {
       case Tok::EndType: case Tok::Method: case Tok::Property: case Tok::Resource:
         return true;
       default:
-        return at_test_block_start() || at_sfc_start() || (in_sfc_action_ && at_word("END_ACTION"));
+        return at_test_block_start() || at_sfc_start() || (!sfc_end_.empty() && at_word(sfc_end_));
     }
   }
   bool looks_like_case_label() const {
@@ -325,13 +325,16 @@ class Parser {
   bool parse_sfc_step_list(std::vector<Ident>& out, const char* what);
   void parse_sfc_action(SfcChart& chart);
   void expect_sfc_end(std::string_view end, const std::string& what, SourceLoc open_loc);
-  bool in_sfc_action_ = false;
+  std::string_view sfc_end_;  // END_ACTION / END_TRANSITION while reading an SFC body
   // ------------------------------------------------------------ Instruction List (parse_il.cpp)
   // The body's first line is an IL instruction: the statements are IL, up to the POU's end.
   bool at_il_body() const;
   bool il_line_at(size_t i, bool formal_call) const;
   bool formal_call_line(size_t open) const;
   void parse_il_body(Pou& pou);
+  // IL statements up to the next terminator into holder.body (an SFC action's or
+  // transition's); with result_var, the final current result is stored into it.
+  void parse_il_into(Pou& holder, const std::string& result_var);
   friend class IlReader;
 
   // ------------------------------------------------------------ test files (parse_tests.cpp)

@@ -141,8 +141,12 @@ class Lowering {
     for (const ActionUse& a : actions_) vars.decls.push_back(At{a.loc}.decl(a.var, "__SFC_ACTION", VarSection::Var));
     vars.decls.push_back(at.decl(kChart, "__SFC_CHART", VarSection::Var));
     temps.decls.push_back(at.decl(kDt, "TIME", VarSection::Temp));
-    for (size_t i = 0; i < chart_.transitions.size(); ++i)
-      temps.decls.push_back(At{chart_.transitions[i].loc}.decl(fired(i), "BOOL", VarSection::Temp));
+    for (size_t i = 0; i < chart_.transitions.size(); ++i) {
+      const SfcTransition& t = chart_.transitions[i];
+      temps.decls.push_back(At{t.loc}.decl(fired(i), "BOOL", VarSection::Temp));
+      if (!t.condition_body.empty())  // an IL condition's value (parse_sfc.cpp names it)
+        temps.decls.push_back(At{t.loc}.decl(static_cast<const NameExpr&>(*t.condition).name.text, "BOOL", VarSection::Temp));
+    }
     pou_.var_blocks.push_back(std::move(vars));
     pou_.var_blocks.push_back(std::move(temps));
 
@@ -171,14 +175,86 @@ class Lowering {
       s->arms.push_back(std::move(final_scan));
       body.push_back(std::move(s));
     }
-    for (SfcAction& act : chart_.actions) {
-      const At aa{act.loc};
-      body.push_back(aa.when(aa.field(act.name.text, "A"), std::move(act.body)));
-    }
+    for (SfcAction& act : chart_.actions) lower_body(act, body);
   }
 
  private:
   static std::string fired(size_t i) { return "__sfc_t" + std::to_string(i); }
+
+  // An ACTION's body runs inline in the chart's call when the action is active. A RETURN
+  // in it ends the action, not the chart, and its labels (IL) are its own: then the body
+  // is entered past a jump to its end, RETURN becomes that jump, and its labels get the
+  // action's name as a prefix.
+  void lower_body(SfcAction& act, StmtList& out) {
+    const At at{act.loc};
+    if (!needs_jumps(act.body)) {
+      out.push_back(at.when(at.field(act.name.text, "A"), std::move(act.body)));
+      return;
+    }
+    const std::string end = "__sfc_end_" + act.name.text;
+    rewrite(act.body, act.name.text, end);
+    out.push_back(at.when(at.not_(at.field(act.name.text, "A")), one(jump(end, act.loc))));
+    for (auto& s : act.body) out.push_back(std::move(s));
+    auto label = std::make_unique<LabelStmt>(act.loc);
+    label->name = Ident{end, act.loc};
+    label->from_il = true;
+    out.push_back(std::move(label));
+  }
+
+  static StmtPtr jump(const std::string& label, SourceLoc loc) {
+    auto j = std::make_unique<JumpStmt>(loc);
+    j->label = Ident{label, loc};
+    j->from_il = true;  // generated: allowed in every dialect
+    return j;
+  }
+
+  // The statement lists nested in s (IF arms, CASE arms, loop bodies).
+  template <class F>
+  static void for_each_list(Stmt& s, F&& f) {
+    switch (s.kind) {
+      case StmtKind::If: {
+        auto& x = static_cast<IfStmt&>(s);
+        for (auto& arm : x.arms) f(arm.body);
+        if (x.else_body) f(*x.else_body);
+        break;
+      }
+      case StmtKind::Case: {
+        auto& x = static_cast<CaseStmt&>(s);
+        for (auto& arm : x.arms) f(arm.body);
+        if (x.else_body) f(*x.else_body);
+        break;
+      }
+      case StmtKind::For: f(static_cast<ForStmt&>(s).body); break;
+      case StmtKind::While: f(static_cast<WhileStmt&>(s).body); break;
+      case StmtKind::Repeat: f(static_cast<RepeatStmt&>(s).body); break;
+      default: break;
+    }
+  }
+
+  static bool needs_jumps(StmtList& list) {
+    for (auto& s : list) {
+      if (s->kind == StmtKind::Return || s->kind == StmtKind::Label || s->kind == StmtKind::Jump) return true;
+      bool nested = false;
+      for_each_list(*s, [&](StmtList& l) { nested = nested || needs_jumps(l); });
+      if (nested) return true;
+    }
+    return false;
+  }
+
+  static void rewrite(StmtList& list, const std::string& action, const std::string& end) {
+    for (auto& s : list) {
+      if (s->kind == StmtKind::Return) {
+        s = jump(end, s->loc);
+      } else if (s->kind == StmtKind::Label) {
+        auto& l = static_cast<LabelStmt&>(*s);
+        l.name.text = "__sfc_" + action + "_" + l.name.text;
+      } else if (s->kind == StmtKind::Jump && static_cast<JumpStmt&>(*s).label.text != end) {
+        auto& j = static_cast<JumpStmt&>(*s);
+        j.label.text = "__sfc_" + action + "_" + j.label.text;
+      }
+      for_each_list(*s, [&](StmtList& l) { rewrite(l, action, end); });
+    }
+  }
 
   // A step or ACTION is a variable of the POU: its name cannot be one of the POU's own.
   bool clashes(const Ident& name, const char* kind) {
@@ -297,7 +373,9 @@ class Lowering {
         fire.push_back(at.assign(at.field(s.text, "X"), at.boolean(false)));
       }
       out.push_back(at.assign(at.name(fired(i)), at.boolean(false)));
-      out.push_back(at.when(std::move(enabled), one(at.when(std::move(t.condition), std::move(fire)))));
+      StmtList test = std::move(t.condition_body);  // an IL condition's instructions first
+      test.push_back(at.when(std::move(t.condition), std::move(fire)));
+      out.push_back(at.when(std::move(enabled), std::move(test)));
     }
     for (size_t i = 0; i < chart_.transitions.size(); ++i) {
       const SfcTransition& t = chart_.transitions[i];

@@ -397,16 +397,21 @@ TEST(PlcopenImport, LadderDiagramLimits) {
 TEST(PlcopenImport, GraphicalBodyIsOneErrorAtTheBody) {
   XmlFile f(project(R"(<pou name="Conveyor" pouType="program">
   <interface/>
+  <actions><action name="Jog">
   <body>
     <FBD><inVariable localId="1"/></FBD>
   </body>
+  </action></actions>
+  <body><ST>;</ST></body>
 </pou>
 <pou name="Uses" pouType="program">
   <interface><localVars><variable name="c"><type><derived name="Conveyor"/></type></variable></localVars></interface>
 </pou>
 )"));
   bool ok = true;
-  EXPECT_EQ(build_diags(f, &ok), "X.xml:6:3: error[ST604]: POU 'Conveyor' has an FBD body: plcfi runs ST bodies only\n"
+  EXPECT_EQ(build_diags(f, &ok), "X.xml:7:3: error[ST604]: action 'Jog' of POU 'Conveyor' has an FBD body: plcfi reads "
+                                 "LD, FBD and SFC bodies of POUs, not of methods, actions or property accessors (write this "
+                                 "one in ST or IL)\n"
                                  "    <body>\n"
                                  "    ^\n");
   EXPECT_FALSE(ok);
