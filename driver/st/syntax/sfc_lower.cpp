@@ -96,6 +96,13 @@ StmtList one(StmtPtr s) {
   return list;
 }
 
+// The literal TRUE (BOOL#TRUE included).
+bool is_true(const Expr& e) {
+  if (e.kind != ExprKind::Literal) return false;
+  const auto& lit = static_cast<const LiteralExpr&>(e);
+  return lit.lit == LiteralKind::Bool && lit.int_value == 1;
+}
+
 // OR of the activity flags of `steps` (at least one).
 ExprPtr any_active(const At& at, const std::vector<std::string>& steps) {
   ExprPtr e = at.field(steps.front(), "X");
@@ -373,8 +380,14 @@ class Lowering {
         fire.push_back(at.assign(at.field(s.text, "X"), at.boolean(false)));
       }
       out.push_back(at.assign(at.name(fired(i)), at.boolean(false)));
+      // `:= TRUE` (an unconditional transition, e.g. after a one-scan step) fires whenever
+      // its steps are active: no IF on a constant condition (warning ST404).
       StmtList test = std::move(t.condition_body);  // an IL condition's instructions first
-      test.push_back(at.when(std::move(t.condition), std::move(fire)));
+      if (is_true(*t.condition)) {
+        for (auto& f : fire) test.push_back(std::move(f));
+      } else {
+        test.push_back(at.when(std::move(t.condition), std::move(fire)));
+      }
       out.push_back(at.when(std::move(enabled), std::move(test)));
     }
     for (size_t i = 0; i < chart_.transitions.size(); ++i) {
