@@ -438,7 +438,8 @@ void Compiler::if_stmt(const IfStmt& s) {
     if (c.ok) branch_on(c, arm.cond->loc, next, false);
     b_->temp_top = saved;
     {
-      ArmScope in(b_, branch(arm.loc, i == 0 ? "IF" : "ELSIF", s.loc, &decision, arm.body));
+      const char* kind = !arm.label.empty() ? arm.label.c_str() : i == 0 ? "IF" : "ELSIF";
+      ArmScope in(b_, branch(arm.loc, kind, s.loc, &decision, arm.body));
       stmts(arm.body);
     }
     if (i + 1 < s.arms.size() || s.else_body) emit(Op::JMP, {Arg::target(end.id)});

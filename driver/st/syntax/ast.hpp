@@ -312,7 +312,8 @@ struct IfStmt : Stmt {
   struct Arm {
     ExprPtr cond;
     StmtList body;
-    SourceLoc loc;  // the IF / ELSIF keyword
+    SourceLoc loc;      // the IF / ELSIF keyword
+    std::string label;  // coverage: what the arm means when generated (an SFC transition fires); empty: IF/ELSIF
   };
   std::vector<Arm> arms;  // IF then ELSIFs
   std::optional<StmtList> else_body;

@@ -63,12 +63,15 @@ struct At {
     s->rhs = std::move(rhs);
     return s;
   }
-  StmtPtr when(ExprPtr cond, StmtList then, std::optional<StmtList> otherwise = std::nullopt) const {
+  // IF cond THEN then [ELSE otherwise]; `label` names the arm in coverage reports.
+  StmtPtr when(ExprPtr cond, StmtList then, std::optional<StmtList> otherwise = std::nullopt,
+               std::string label = {}) const {
     auto s = std::make_unique<IfStmt>(l);
     IfStmt::Arm arm;
     arm.cond = std::move(cond);
     arm.body = std::move(then);
     arm.loc = l;
+    arm.label = std::move(label);
     s->arms.push_back(std::move(arm));
     if (otherwise) {
       s->else_body = std::move(otherwise);
@@ -165,10 +168,11 @@ class Lowering {
       const At st{s.loc};
       evolve.push_back(st.when(st.field(s.name.text, "X"),
                                one(st.assign(st.field(s.name.text, "T"),
-                                             st.bin(BinaryOp::Add, st.field(s.name.text, "T"), st.name(kDt))))));
+                                             st.bin(BinaryOp::Add, st.field(s.name.text, "T"), st.name(kDt)))),
+                               std::nullopt, "step " + s.name.text + " active"));
     }
     lower_transitions(evolve);
-    body.push_back(at.when(at.field(kChart, "started"), std::move(evolve)));
+    body.push_back(at.when(at.field(kChart, "started"), std::move(evolve), std::nullopt, "chart evolves"));
     body.push_back(at.assign(at.field(kChart, "started"), at.boolean(true)));
     body.push_back(at.assign(at.field(kChart, "last"), at.now()));
     for (const ActionUse& a : actions_) lower_control(a, body);
@@ -176,8 +180,10 @@ class Lowering {
       if (a.bool_var.empty()) continue;
       const At aa{a.loc};
       auto s = std::make_unique<IfStmt>(a.loc);
-      IfStmt::Arm on{aa.field(a.var, "Q"), one(aa.assign(aa.name(a.bool_var), aa.boolean(true))), a.loc};
-      IfStmt::Arm final_scan{aa.field(a.var, "A"), one(aa.assign(aa.name(a.bool_var), aa.boolean(false))), a.loc};
+      IfStmt::Arm on{aa.field(a.var, "Q"), one(aa.assign(aa.name(a.bool_var), aa.boolean(true))), a.loc,
+                     "action " + a.bool_var + " active"};
+      IfStmt::Arm final_scan{aa.field(a.var, "A"), one(aa.assign(aa.name(a.bool_var), aa.boolean(false))), a.loc,
+                             "action " + a.bool_var + " final scan"};
       s->arms.push_back(std::move(on));
       s->arms.push_back(std::move(final_scan));
       body.push_back(std::move(s));
@@ -188,6 +194,17 @@ class Lowering {
  private:
   static std::string fired(size_t i) { return "__sfc_t" + std::to_string(i); }
 
+  // "transition Fill -> (Heat, Mix)", "transition Full (Fill -> Heat)" in coverage reports.
+  static std::string describe(const SfcTransition& t) {
+    const auto list = [](const std::vector<Ident>& steps) {
+      std::string s = steps.size() == 1 ? "" : "(";
+      for (size_t i = 0; i < steps.size(); ++i) s += (i ? ", " : "") + steps[i].text;
+      return steps.size() == 1 ? s : s + ")";
+    };
+    const std::string arrow = list(t.from) + " -> " + list(t.to);
+    return "transition " + (t.name ? t.name->text + " (" + arrow + ")" : arrow);
+  }
+
   // An ACTION's body runs inline in the chart's call when the action is active. A RETURN
   // in it ends the action, not the chart, and its labels (IL) are its own: then the body
   // is entered past a jump to its end, RETURN becomes that jump, and its labels get the
@@ -195,12 +212,13 @@ class Lowering {
   void lower_body(SfcAction& act, StmtList& out) {
     const At at{act.loc};
     if (!needs_jumps(act.body)) {
-      out.push_back(at.when(at.field(act.name.text, "A"), std::move(act.body)));
+      out.push_back(at.when(at.field(act.name.text, "A"), std::move(act.body), std::nullopt, "action " + act.name.text + " runs"));
       return;
     }
     const std::string end = "__sfc_end_" + act.name.text;
     rewrite(act.body, act.name.text, end);
-    out.push_back(at.when(at.not_(at.field(act.name.text, "A")), one(jump(end, act.loc))));
+    out.push_back(at.when(at.not_(at.field(act.name.text, "A")), one(jump(end, act.loc)), std::nullopt,
+                          "action " + act.name.text + " skipped"));
     for (auto& s : act.body) out.push_back(std::move(s));
     auto label = std::make_unique<LabelStmt>(act.loc);
     label->name = Ident{end, act.loc};
@@ -383,12 +401,13 @@ class Lowering {
       // `:= TRUE` (an unconditional transition, e.g. after a one-scan step) fires whenever
       // its steps are active: no IF on a constant condition (warning ST404).
       StmtList test = std::move(t.condition_body);  // an IL condition's instructions first
+      const std::string name = describe(t);
       if (is_true(*t.condition)) {
         for (auto& f : fire) test.push_back(std::move(f));
       } else {
-        test.push_back(at.when(std::move(t.condition), std::move(fire)));
+        test.push_back(at.when(std::move(t.condition), std::move(fire), std::nullopt, name + " fires"));
       }
-      out.push_back(at.when(std::move(enabled), std::move(test)));
+      out.push_back(at.when(std::move(enabled), std::move(test), std::nullopt, name + " enabled"));
     }
     for (size_t i = 0; i < chart_.transitions.size(); ++i) {
       const SfcTransition& t = chart_.transitions[i];
@@ -398,7 +417,7 @@ class Lowering {
         enter.push_back(at.assign(at.field(s.text, "X"), at.boolean(true)));
         enter.push_back(at.assign(at.field(s.text, "T"), at.zero_time()));
       }
-      out.push_back(at.when(at.name(fired(i)), std::move(enter)));
+      out.push_back(at.when(at.name(fired(i)), std::move(enter), std::nullopt, describe(t) + " enters its steps"));
     }
   }
 
@@ -447,8 +466,10 @@ class Lowering {
     if (q == "SD" || q == "SL") flip_flop(at.field(a.timed_step, "X"));
     const auto timer_in = [&]() { return q == "SD" || q == "SL" ? f("__ff") : at.field(a.timed_step, "X"); };
     StmtList running;
-    running.push_back(at.when(f("__run"), one(at.assign(f("__et"), at.bin(BinaryOp::Add, f("__et"), at.name(kDt))))));
-    out.push_back(at.when(timer_in(), std::move(running), one(at.assign(f("__et"), at.zero_time()))));
+    const std::string what = "action " + as.action.text + " " + q + " timer";
+    running.push_back(at.when(f("__run"), one(at.assign(f("__et"), at.bin(BinaryOp::Add, f("__et"), at.name(kDt)))),
+                              std::nullopt, what + " counts"));
+    out.push_back(at.when(timer_in(), std::move(running), one(at.assign(f("__et"), at.zero_time())), what + " on"));
     out.push_back(at.assign(f("__run"), timer_in()));
     out.push_back(at.assign(f("__tq"), at.and_(timer_in(), at.bin(BinaryOp::Ge, f("__et"), std::move(as.time)))));
     if (q == "L") return at.and_(at.field(a.timed_step, "X"), at.not_(f("__tq")));
