@@ -3,6 +3,7 @@
 #include "import/xml_nodes.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <map>
 #include <queue>
@@ -94,14 +95,14 @@ class Translator {
       if (kind == "comment" || kind == "addData" || kind == "documentation") continue;
       static const std::set<std::string> kLd = {"leftPowerRail", "rightPowerRail", "contact", "coil", "block",
                                                "inVariable", "outVariable", "inOutVariable", "connector",
-                                               "continuation"};
+                                               "continuation", "jump", "label", "return"};
       static const std::set<std::string> kFbd = {"block", "inVariable", "outVariable", "inOutVariable", "connector",
-                                                "continuation"};
+                                                "continuation", "jump", "label", "return"};
       if (!(fbd_ ? kFbd : kLd).count(kind))
         return fail(n, fbd_ ? "the FBD element <" + kind + "> is not supported (plcfi translates blocks, variables, "
-                              "connectors and continuations)"
+                              "connectors, continuations, jumps, labels and returns)"
                             : "the LD element <" + kind + "> is not supported (plcfi translates power rails, contacts, "
-                              "coils, blocks, variables, connectors and continuations)");
+                              "coils, blocks, variables, connectors, continuations, jumps, labels and returns)");
       Element e;
       e.n = n;
       e.kind = kind;
@@ -147,7 +148,8 @@ class Translator {
   // something in the evaluation order.
   bool is_statement(const Element& e) const {
     if (e.kind == "block") return !trimmed(e.n.attribute("instanceName").value()).empty();
-    return e.kind == "outVariable" || e.kind == "inOutVariable" || e.kind == "contact" || e.kind == "coil";
+    return e.kind == "outVariable" || e.kind == "inOutVariable" || e.kind == "contact" || e.kind == "coil" ||
+           e.kind == "jump" || e.kind == "return" || e.kind == "label";
   }
 
   // A connection that may close a loop: it reads a variable (an in-out variable) or a
@@ -164,6 +166,10 @@ class Translator {
   // (Kahn). A loop through an in-out variable or a function block's output is a feedback
   // path (that connection reads the previous value and does not order); any other loop is
   // an error.
+  //
+  // Labels divide the body into networks, in document order (by executionOrderId when
+  // every element that acts has one): each network is ordered on its own and follows the
+  // label that starts it, so a jump to the label runs the networks from there on.
   bool sort(std::vector<const Element*>* out) {
     const size_t n = elements_.size();
     std::vector<std::vector<size_t>> deps(n);
@@ -191,16 +197,41 @@ class Translator {
         return true;
       }
     }
+    std::vector<size_t> members;
+    for (size_t i = 0; i < n; ++i) {
+      if (elements_[i].kind != "label") {
+        members.push_back(i);
+        continue;
+      }
+      if (!sort_network(members, deps, out)) return false;
+      members.clear();
+      out->push_back(&elements_[i]);
+    }
+    return sort_network(members, deps, out);
+  }
+
+  // One network (the elements `members`, indices into elements_): data flow within it; a
+  // connection from another network reads what that one left.
+  bool sort_network(const std::vector<size_t>& members, const std::vector<std::vector<size_t>>& all_deps,
+                    std::vector<const Element*>* out) {
+    const size_t n = elements_.size();
+    std::vector<bool> in(n, false);
+    for (size_t i : members) in[i] = true;
+    std::vector<std::vector<size_t>> deps(n);
+    for (size_t i : members)
+      for (size_t d : all_deps[i])
+        if (in[d]) deps[i].push_back(d);
+    const size_t target = out->size() + members.size();
     std::vector<size_t> missing(n, 0);
     std::vector<std::vector<size_t>> users(n);
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i : members)
       for (size_t d : deps[i]) {
         ++missing[i];
         users[d].push_back(i);
       }
     std::vector<bool> done(n, false);
     std::priority_queue<size_t, std::vector<size_t>, std::greater<>> ready;
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i : members)
       if (!missing[i]) ready.push(i);
     for (;;) {
       while (!ready.empty()) {
@@ -211,10 +242,11 @@ class Translator {
         for (size_t u : users[i])
           if (!done[u] && missing[u] > 0 && --missing[u] == 0) ready.push(u);
       }
-      if (out->size() == n) return true;
+      if (out->size() == target) return true;
       // Stuck on a loop: cut one feedback connection (the first in document order).
       bool cut = false;
-      for (size_t i = 0; i < n && !cut; ++i) {
+      for (size_t i : members) {
+        if (cut) break;
         if (done[i]) continue;
         for (size_t d : deps[i]) {
           if (done[d] || !is_feedback_source(elements_[d])) continue;
@@ -226,7 +258,7 @@ class Translator {
         }
       }
       if (!cut) {
-        for (size_t i = 0; i < n; ++i)
+        for (size_t i : members)
           if (!done[i])
             return fail(elements_[i].n, "the network has a loop through this <" + elements_[i].kind + "> (localId " +
                                             std::to_string(elements_[i].id) +
@@ -356,6 +388,13 @@ class Translator {
     return true;
   }
 
+  static bool is_name(const std::string& s) {
+    if (s.empty() || std::isdigit(static_cast<unsigned char>(s[0]))) return false;
+    for (char c : s)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
+    return true;
+  }
+
   static std::string expression(const Element& e) { return trimmed(child(e.n, "expression").text().get()); }
 
   bool variable(const Element& e, std::string* v) {
@@ -430,6 +469,24 @@ class Translator {
       return true;
     }
     if (e.kind == "block") return block(e);
+    if (e.kind == "label" || e.kind == "jump") {
+      const std::string label = trimmed(e.n.attribute("label").value());
+      if (!is_name(label)) return fail(e.n, "<" + e.kind + "> needs a label that is a name, not '" + label + "'");
+      if (e.kind == "label") {
+        line(label + ":", e);
+        return true;
+      }
+    }
+    if (e.kind == "jump" || e.kind == "return") {
+      // Taken when the power flow (LD) or the BOOL connected to it (FBD) is TRUE.
+      std::string cond = "TRUE";
+      if (!e.inputs.empty() && !e.inputs.front().from.empty() && !input(e, e.inputs.front(), &cond)) return false;
+      const std::string action =
+          e.kind == "jump" ? "JMP " + trimmed(e.n.attribute("label").value()) + ";" : std::string("RETURN;");
+      flush_pending(e);
+      line(cond == "TRUE" ? action : "IF " + cond + " THEN " + action + " END_IF;", e);
+      return true;
+    }
     return true;  // power rails, in-variables, connectors, continuations: values only
   }
 

@@ -13,8 +13,10 @@
 // function block calls (<block>; EN/ENO as ST has them; negated inputs and outputs; edges
 // on function block inputs); input (negated), output (negated) and in-out variables;
 // connectors and continuations; comments. A function's value is written where it is used;
-// one with EN connected must feed an output variable (assigned under EN). Anything else
-// (jumps, labels, returns) is an error naming the element.
+// one with EN connected must feed an output variable (assigned under EN). Labels divide
+// the body into networks (each ordered on its own); a jump or a return is taken when the
+// power flow or the BOOL connected to it is TRUE. Anything else is an error naming the
+// element.
 #pragma once
 
 #include <string>

@@ -377,7 +377,8 @@ struct MockFunctionStmt : Stmt {
 struct LabelStmt : Stmt {
   explicit LabelStmt(SourceLoc l) : Stmt(StmtKind::Label, l) {}
   Ident name;
-  bool from_il = false;  // written in Instruction List (IEC), not ST (CODESYS only)
+  // Written in Instruction List or generated from an LD/FBD jump (IEC), not ST (CODESYS only).
+  bool from_il = false;
 };
 
 struct JumpStmt : Stmt {

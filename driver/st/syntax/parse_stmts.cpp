@@ -89,12 +89,14 @@ StmtPtr Parser::parse_statement() {
       if (iequals(t.text, "JMP") && la(1).kind == Tok::Ident && la(2).kind == Tok::Semi) {
         advance();
         auto j = std::make_unique<JumpStmt>(t.loc);
+        j->from_il = synthesized_line(t.loc.line);
         j->label = Ident{std::string(advance().text), prev().loc};
         advance();  // ';'
         return j;
       }
       if (la(1).kind == Tok::Colon) {
         auto l = std::make_unique<LabelStmt>(t.loc);
+        l->from_il = synthesized_line(t.loc.line);
         l->name = Ident{std::string(t.text), t.loc};
         advance();
         advance();  // ':'

@@ -145,6 +145,11 @@ class Parser {
     return true;
   }
   bool first_on_line(size_t i) const { return i == 0 || tok(i).loc.line != tok(i - 1).loc.line; }
+  // A line an importer wrote itself (an LD/FBD network's jump or label), not user text.
+  bool synthesized_line(uint32_t line) const {
+    const auto& origins = sm_.file(file_).origins;
+    return line >= 1 && line <= origins.size() && !origins[line - 1].where.exact_columns;
+  }
 
   // ------------------------------------------------------------ diagnostics
   static std::string describe(const Token& t) {
