@@ -74,14 +74,10 @@ const CallArg* enable_arg(const CallExpr& c, bool eno) {
 Val Compiler::call(const CallExpr& c, bool as_statement) {
   mark(c.loc);
   const Expr& callee = *c.callee;
-  for (const CallArg* a : {enable_arg(c, false), enable_arg(c, true)}) {
-    const PouInfo* p = a ? callee_pou(callee) : nullptr;
-    if (a && !(p && p->find_var(a->is_output ? "ENO" : "EN"))) {
-      diags_.error("ST210", a->loc, std::string(a->is_output ? "ENO" : "EN") +
-                                        " on a call inside an expression: with EN FALSE the call has no value to give; "
-                                        "assign the call's value to a variable (r := F(EN := c, ...)) or make the call a statement");
-      return bad();
-    }
+  if (!as_statement) {
+    const CallArg* en = nullptr;
+    const CallArg* eno = nullptr;
+    if (implicit_enable(c, &en, &eno)) return enabled_value(c);
   }
   auto void_val = [&]() {
     Val v;
@@ -254,69 +250,134 @@ const PouInfo* Compiler::callee_pou(const Expr& callee) {
 // FALSE the POU does not run, its outputs are not captured and the variable its value is
 // assigned to keeps its value (as an FBD box's connected variable does; MATIEC writes the
 // result type's initial value instead); ENO is EN. A POU that declares EN or ENO itself
-// takes them as ordinary parameters. A call with EN nested inside an expression has no
-// variable to keep: an error, not a made-up value.
+// takes them as ordinary parameters. A call with EN nested inside an expression (an FBD
+// box feeding another) has the result type's initial value when EN is FALSE, as MATIEC
+// computes it: enabled_value.
 bool Compiler::enabled_call(const CallExpr& c, const AssignStmt* assignment) {
-  const CallArg* en = enable_arg(c, false);
-  const CallArg* eno = enable_arg(c, true);
-  if (!en && !eno) return false;
-  if (const PouInfo* p = callee_pou(*c.callee)) {
-    if (en && p->find_var("EN")) en = nullptr;
-    if (eno && p->find_var("ENO")) eno = nullptr;
-    if (!en && !eno) return false;
+  const CallArg* en = nullptr;
+  const CallArg* eno = nullptr;
+  if (!implicit_enable(c, &en, &eno)) return false;
+  Val enabled;
+  if (!enable_flag(c, en, &enabled)) return true;
+  Label skip = new_label();
+  if (en) branch_on(enabled, c.loc, skip, false);
+  without_enable(c, en, eno, [&] {
+    if (assignment) assign_stmt(*assignment);
+    else call(c, true);
+  });
+  bind(skip);
+  b_->cvt_cache.clear();  // conversions cached in the skipped code were not computed
+  capture_eno(c, enabled);
+  return true;
+}
+
+Val Compiler::enabled_value(const CallExpr& c) {
+  const CallArg* en = nullptr;
+  const CallArg* eno = nullptr;
+  implicit_enable(c, &en, &eno);
+  Val enabled;
+  if (!enable_flag(c, en, &enabled)) return bad();
+  Label off = new_label(), done = new_label();
+  if (en) branch_on(enabled, c.loc, off, false);
+  Val r;
+  without_enable(c, en, eno, [&] { r = call(c, false); });
+  if (!r.ok) return bad();
+  const Type* t = r.type ? r.type : default_type(r.c);
+  if (!t || t->kind == TypeKind::Void || t->kind == TypeKind::Pou) {
+    diags_.error("ST210", c.loc, "this call with EN gives no value to use in an expression; make it a statement");
+    return bad();
   }
+  Slot result = temp_for(t);
+  assign(frame_place(result, t), r, c.loc);
+  emit(Op::JMP, {Arg::target(done.id)});
+  bind(off);
+  // Not executed: the result type's initial value.
+  const uint32_t size = t->size ? t->size : 1;
+  const uint32_t blob = alloc(size, 8);
+  std::copy(t->init.begin(), t->init.begin() + std::min<size_t>(t->init.size(), size), app_->init_image.begin() + blob);
+  switch (size) {
+    case 1: emit(Op::LDG1, {result, blob}); break;
+    case 2: emit(Op::LDG2, {result, blob}); break;
+    case 4: emit(Op::LDG4, {result, blob}); break;
+    case 8: emit(Op::LDG8, {result, blob}); break;
+    default: emit(Op::INITBLK, {result, blob, size}); break;
+  }
+  bind(done);
+  b_->cvt_cache.clear();
+  capture_eno(c, enabled);
+  Val out;
+  out.type = t;
+  out.slot = result;
+  return out;
+}
+
+// The EN input and ENO output a call names that its POU does not declare itself; false
+// when there are none.
+bool Compiler::implicit_enable(const CallExpr& c, const CallArg** en, const CallArg** eno) {
+  *en = enable_arg(c, false);
+  *eno = enable_arg(c, true);
+  if (!*en && !*eno) return false;
+  if (const PouInfo* p = callee_pou(*c.callee)) {
+    if (*en && p->find_var("EN")) *en = nullptr;
+    if (*eno && p->find_var("ENO")) *eno = nullptr;
+  }
+  return *en || *eno;
+}
+
+// The call's EN in a BOOL temporary (TRUE when it names none). False after an error.
+bool Compiler::enable_flag(const CallExpr& c, const CallArg* en, Val* enabled) {
   const Type* boolean = elem(TypeKind::Bool);
   Slot flag = temp(1, 1);
   Place flag_place = frame_place(flag, boolean);
-  Val enabled;
-  enabled.type = boolean;
-  enabled.slot = flag;
+  enabled->type = boolean;
+  enabled->slot = flag;
   if (en) {
     Val v = en->value ? expr(*en->value, boolean) : bad();
-    if (!v.ok) return true;
+    if (!v.ok) return false;
     if (!v.type || v.type->kind != TypeKind::Bool) {
       diags_.error("ST204", en->value->loc, "EN needs a BOOL, not " + tname(v.type));
-      return true;
+      return false;
     }
     assign(flag_place, v, en->loc);
   } else {
     store(flag_place, konst(boolean, ConstV{ConstV::K::Bool, 1, 0, {}}, c.loc));
   }
-  Label skip = new_label();
-  if (en) branch_on(enabled, c.loc, skip, false);
-  {
-    // The call proper, without EN and ENO: they are taken out of the argument list while
-    // it compiles and put back where they were (the tree is compiled more than once).
-    auto& args = const_cast<std::vector<CallArg>&>(c.args);
-    std::vector<std::pair<size_t, CallArg>> held;
-    for (size_t i = args.size(); i-- > 0;)
-      if (&args[i] == en || &args[i] == eno) {
-        held.emplace_back(i, std::move(args[i]));
-        args.erase(args.begin() + static_cast<std::ptrdiff_t>(i));
-      }
-    if (assignment) assign_stmt(*assignment);
-    else call(c, true);
-    for (auto it = held.rbegin(); it != held.rend(); ++it)
-      args.insert(args.begin() + static_cast<std::ptrdiff_t>(it->first), std::move(it->second));
-    if (eno) eno = enable_arg(c, true);  // the element back in its place, not the old pointer
-  }
-  bind(skip);
-  if (eno && eno->value) {
-    Place target = place(*eno->value, true);
-    if (!target.ok) return true;
-    if (target.type->kind != TypeKind::Bool) {
-      diags_.error("ST203", eno->value->loc, "ENO is a BOOL; " + tname(target.type) + " cannot take it");
-      return true;
-    }
-    Val out = enabled;
-    if (eno->negate) {
-      Slot n = temp(1, 1);
-      emit(Op::BNOT, {n, flag});
-      out.slot = n;
-    }
-    assign(target, out, eno->loc);
-  }
   return true;
+}
+
+// Compiles `body` with EN and ENO taken out of the call's argument list; they are put back
+// where they were afterwards (the tree is compiled more than once).
+void Compiler::without_enable(const CallExpr& c, const CallArg* en, const CallArg* eno, const std::function<void()>& body) {
+  auto& args = const_cast<std::vector<CallArg>&>(c.args);
+  std::vector<std::pair<size_t, CallArg>> held;
+  for (size_t i = args.size(); i-- > 0;)
+    if (&args[i] == en || &args[i] == eno) {
+      held.emplace_back(i, std::move(args[i]));
+      args.erase(args.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+  body();
+  for (auto it = held.rbegin(); it != held.rend(); ++it)
+    args.insert(args.begin() + static_cast<std::ptrdiff_t>(it->first), std::move(it->second));
+}
+
+// ENO => target (or NOT ENO => target): the EN flag.
+void Compiler::capture_eno(const CallExpr& c, const Val& enabled) {
+  const CallArg* eno = enable_arg(c, true);
+  if (const PouInfo* p = callee_pou(*c.callee); p && p->find_var("ENO")) eno = nullptr;
+  if (!eno || !eno->value) return;
+  Place target = place(*eno->value, true);
+  if (!target.ok) return;
+  if (target.type->kind != TypeKind::Bool) {
+    diags_.error("ST203", eno->value->loc, "ENO is a BOOL; " + tname(target.type) + " cannot take it");
+    return;
+  }
+  Val out = enabled;
+  if (eno->negate) {
+    Slot n = temp(1, 1);
+    emit(Op::BNOT, {n, enabled.slot});
+    out.slot = n;
+  }
+  assign(target, out, eno->loc);
 }
 
 // ------------------------------------------------------------------ functions

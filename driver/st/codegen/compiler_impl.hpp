@@ -8,6 +8,7 @@
 // that an FB's instance size or a function's frame size is known before a caller needs it.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <tuple>
 #include <memory>
@@ -361,6 +362,13 @@ class Compiler {
   // A call with EN/ENO (a statement, or the value of an assignment): IF EN THEN ... END_IF
   // and ENO := EN. False when the call has no EN/ENO of the implicit kind.
   bool enabled_call(const CallExpr& c, const AssignStmt* assignment);
+  // A call with EN inside an expression: its value when EN holds, else the result type's
+  // initial value.
+  Val enabled_value(const CallExpr& c);
+  bool implicit_enable(const CallExpr& c, const CallArg** en, const CallArg** eno);
+  bool enable_flag(const CallExpr& c, const CallArg* en, Val* enabled);
+  void without_enable(const CallExpr& c, const CallArg* en, const CallArg* eno, const std::function<void()>& body);
+  void capture_eno(const CallExpr& c, const Val& enabled);
   const PouInfo* callee_pou(const Expr& callee);
   bool may_call(const Expr& e) const;
   Val call_function(PouInfo* f, const CallExpr& c);

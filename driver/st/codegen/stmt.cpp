@@ -330,8 +330,8 @@ void Compiler::assign_stmt(const AssignStmt& s) {
     bind(skip);
     return;
   }
+  if (s.declares_temp) return declare_temp(s);  // with EN: the value, or the type's initial value
   if (s.rhs->kind == ExprKind::Call && enabled_call(static_cast<const CallExpr&>(*s.rhs), &s)) return;
-  if (s.declares_temp) return declare_temp(s);
   // Warn about x := x, a typing accident more often than intent.
   if (opt_.warnings && s.lhs->kind == ExprKind::Name && s.rhs->kind == ExprKind::Name &&
       iequals(static_cast<const NameExpr&>(*s.lhs).name.text, static_cast<const NameExpr&>(*s.rhs).name.text))
