@@ -45,29 +45,35 @@ struct Element {
   long id = 0;
   size_t order = 0;  // document order
   long exec_order = 0;  // executionOrderId (FBD), 0 when not given
+  std::string instance;  // a block's instanceName, trimmed (empty: a function)
+  std::string target;    // a coil's or output variable's variable, when a condition renames it
   std::vector<Input> inputs;
 };
 
 class Translator {
  public:
-  Translator(const std::string& what, bool fbd, bool instances, LdTranslation* out, LdError* err)
-      : what_(what), fbd_(fbd), instances_(instances), out_(out), err_(err) {}
+  Translator(const std::string& what, bool fbd, bool instances, LdTranslation* out, LdError* err,
+             const LdCondition* cond = nullptr)
+      : what_(what), fbd_(fbd), instances_(instances), out_(out), err_(err), cond_(cond) {
+    if (cond_) tag_ = cond_->tag;
+  }
 
   bool run(const pugi::xml_node& ld) {
     if (!collect(ld)) return false;
+    if (cond_ && !condition()) return false;
     std::vector<const Element*> order;
     if (!sort(&order)) return false;
     for (const Element* e : order)
       if (!emit(*e)) return false;
     if (!temps_.empty() || !enos_.empty()) {
       out_->vars.push_back({"VAR_TEMP", ld});
-      for (long id : temps_) out_->vars.push_back({"  _ld" + std::to_string(id) + " : BOOL;", ld});
-      for (long id : enos_) out_->vars.push_back({"  _ldeno" + std::to_string(id) + " : BOOL;", ld});
+      for (long id : temps_) out_->vars.push_back({"  " + nm("", id) + " : BOOL;", ld});
+      for (long id : enos_) out_->vars.push_back({"  " + nm("eno", id) + " : BOOL;", ld});
       out_->vars.push_back({"END_VAR", ld});
     }
     if (!edges_.empty() || !edge_inputs_.empty()) {
       out_->vars.push_back({"VAR", ld});
-      for (const auto& [id, type] : edges_) out_->vars.push_back({"  _lde" + std::to_string(id) + " : " + type + ";", ld});
+      for (const auto& [id, type] : edges_) out_->vars.push_back({"  " + nm("e", id) + " : " + type + ";", ld});
       for (const auto& [name, type] : edge_inputs_) out_->vars.push_back({"  " + name + " : " + type + ";", ld});
       out_->vars.push_back({"END_VAR", ld});
     }
@@ -98,7 +104,11 @@ class Translator {
                                                "continuation", "jump", "label", "return"};
       static const std::set<std::string> kFbd = {"block", "inVariable", "outVariable", "inOutVariable", "connector",
                                                 "continuation", "jump", "label", "return"};
-      if (!(fbd_ ? kFbd : kLd).count(kind))
+      static const std::set<std::string> kSfc = {"step", "transition", "selectionDivergence", "selectionConvergence",
+                                                "simultaneousDivergence", "simultaneousConvergence", "jumpStep",
+                                                "actionBlock", "macroStep"};
+      if (cond_ && cond_->root && kSfc.count(kind)) continue;  // the chart around a condition's network
+      if (cond_ && cond_->root ? !kLd.count(kind) && !kFbd.count(kind) : !(fbd_ ? kFbd : kLd).count(kind))
         return fail(n, fbd_ ? "the FBD element <" + kind + "> is not supported (plcfi translates blocks, variables, "
                               "connectors, continuations, jumps, labels and returns)"
                             : "the LD element <" + kind + "> is not supported (plcfi translates power rails, contacts, "
@@ -113,6 +123,7 @@ class Translator {
       e.id = std::strtol(id, &end, 10);
       if (!*id || *end) return fail(n, "<" + kind + "> needs a numeric localId");
       if (kind == "block") {
+        e.instance = trimmed(n.attribute("instanceName").value());
         for (auto v : child(n, "inputVariables").children())
           if (is(v, "variable"))
             e.inputs.push_back(Input{v.attribute("formalParameter").value(), v.attribute("negated").as_bool(),
@@ -125,9 +136,34 @@ class Translator {
       }
       if (kind == "connector") connectors_[trimmed(n.attribute("name").value())] = e.id;
       for (const auto& in : e.inputs)
-        for (const auto& c : in.from) read_.insert(c.ref);
+        for (const auto& c : in.from) {
+          read_.insert(c.ref);
+          if (c.formal == "ENO") eno_read_.insert(c.ref);
+        }
       if (!by_id_.emplace(e.id, elements_.size()).second) return fail(n, "localId " + std::to_string(e.id) + " is used twice");
       elements_.push_back(std::move(e));
+    }
+    // A function box with EN connected (or its ENO read) whose value other elements read is
+    // held: evaluated once, in its place in the order, into a hidden temporary
+    // (`_ldv<id> := F(EN := ..., ENO => _ldeno<id>)`: with EN FALSE it holds the result
+    // type's initial value, as MATIEC computes it), which its readers read.
+    // One output variable wired alone to such a box is assigned under EN instead (see
+    // emit): with EN FALSE it keeps its value.
+    std::map<long, int> readers, direct;
+    for (const Element& e : elements_)
+      for (const auto& in : e.inputs)
+        for (const auto& c : in.from) {
+          ++readers[c.ref];
+          if ((e.kind == "outVariable" || e.kind == "inOutVariable") && in.from.size() == 1 && !in.negated &&
+              !e.n.attribute("negated").as_bool())
+            ++direct[c.ref];
+        }
+    for (const Element& e : elements_) {
+      if (e.kind != "block" || !e.instance.empty() || !read_.count(e.id)) continue;
+      bool enabled = false;
+      for (const auto& in : e.inputs)
+        if (in.formal == "EN" && !in.from.empty()) enabled = true;
+      if (eno_read_.count(e.id) || (enabled && (readers[e.id] > 1 || direct[e.id] == 0))) held_.insert(e.id);
     }
     return true;
   }
@@ -147,7 +183,7 @@ class Translator {
   // Whether element i only gives a value (written where it is used) rather than doing
   // something in the evaluation order.
   bool is_statement(const Element& e) const {
-    if (e.kind == "block") return !trimmed(e.n.attribute("instanceName").value()).empty();
+    if (e.kind == "block") return !e.instance.empty() || held_.count(e.id);
     return e.kind == "outVariable" || e.kind == "inOutVariable" || e.kind == "contact" || e.kind == "coil" ||
            e.kind == "jump" || e.kind == "return" || e.kind == "label";
   }
@@ -156,7 +192,7 @@ class Translator {
   // function block instance's output, so it gives the value of the previous evaluation
   // (the standard's feedback path) and need not come first.
   bool is_feedback_source(const Element& e) const {
-    return e.kind == "inOutVariable" || (e.kind == "block" && !trimmed(e.n.attribute("instanceName").value()).empty());
+    return e.kind == "inOutVariable" || (e.kind == "block" && !e.instance.empty());
   }
 
   // The evaluation order. FBD with an executionOrderId on every element that does something
@@ -272,7 +308,7 @@ class Translator {
   bool value(long id, const std::string& formal, const pugi::xml_node& user, std::string* v) {
     const Element& e = elements_[by_id_.at(id)];
     if (e.kind == "leftPowerRail") *v = "TRUE";
-    else if (e.kind == "contact" || e.kind == "coil") *v = "_ld" + std::to_string(id);
+    else if (e.kind == "contact" || e.kind == "coil") *v = nm("", id);
     else if (e.kind == "inVariable" || e.kind == "inOutVariable")
       *v = std::string(e.n.attribute("negated").as_bool() ? "NOT " : "") + "(" + expression(e) + ")";
     else if (e.kind == "continuation") {
@@ -292,7 +328,7 @@ class Translator {
     return true;
   }
 
-  static std::string inst_of(const Element& e) { return trimmed(e.n.attribute("instanceName").value()); }
+  static const std::string& inst_of(const Element& e) { return e.instance; }
   static std::string type_of(const Element& e) { return trimmed(e.n.attribute("typeName").value()); }
 
   // Whether output `formal` of block e is drawn negated.
@@ -326,7 +362,7 @@ class Translator {
       if (!input(e, in, &v)) return false;
       if (!in.edge.empty() && in.edge != "none") {
         if (!instances_) return fail(e.n, "an edge on input '" + in.formal + "' needs an R_TRIG/F_TRIG instance, which a FUNCTION cannot hold");
-        const std::string trig = "_lde" + std::to_string(e.id) + "_" + std::to_string(k);
+        const std::string trig = nm("e", e.id) + "_" + std::to_string(k);
         edge_inputs_.emplace_back(trig, in.edge == "falling" ? "F_TRIG" : "R_TRIG");
         pending_.push_back(trig + "(CLK := " + v + ");");
         v = trig + ".Q";
@@ -345,18 +381,21 @@ class Translator {
     if (!inst.empty()) {
       if (formal == "ENO") {
         enos_.insert(e.id);
-        *v = "_ldeno" + std::to_string(e.id);
+        *v = nm("eno", e.id);
       } else {
         *v = (output_negated(e, formal) ? "NOT " : "") + inst + "." + (formal.empty() ? "Q" : formal);
       }
       return true;
     }
-    std::string en;
-    if (!enable(e, &en)) return false;
-    if (!en.empty() || formal == "ENO")
-      return fail(user, "reads function " + type_of(e) + " (localId " + std::to_string(e.id) +
-                            "), whose EN or ENO is connected: connect its value straight to an output variable, "
-                            "where plcfi assigns it under EN");
+    if (held_.count(e.id)) {
+      if (formal == "ENO") {
+        *v = nm("eno", e.id);
+      } else {
+        *v = (output_negated(e, formal) ? "NOT " : "") + nm("v", e.id);
+      }
+      return true;
+    }
+    static_cast<void>(user);
     if (++depth_ > kMaxDepth) return fail(e.n, "function boxes nest too deep");
     std::string args;
     const bool ok = arguments(e, false, &args);
@@ -399,6 +438,7 @@ class Translator {
 
   bool variable(const Element& e, std::string* v) {
     *v = trimmed(child(e.n, "variable").text().get());
+    if (!e.target.empty()) *v = e.target;
     if (v->empty()) return fail(e.n, "<" + e.kind + "> names no <variable>");
     return true;
   }
@@ -411,8 +451,8 @@ class Translator {
   void line(const std::string& text, const Element& e) { out_->body.push_back({text, e.n}); }
 
   bool emit(const Element& e) {
-    const std::string id = std::to_string(e.id);
     if (e.kind == "contact" || e.kind == "coil") {
+      const std::string t = nm("", e.id), te = nm("e", e.id);
       std::string in, var;
       if (!input(e, e.inputs.empty() ? Input{} : e.inputs.front(), &in) || !variable(e, &var)) return false;
       const bool negated = e.n.attribute("negated").as_bool();
@@ -424,41 +464,39 @@ class Translator {
       temps_.push_back(e.id);
       if (e.kind == "contact") {
         if (!trig.empty()) {
-          line("_lde" + id + "(CLK := " + var + ");", e);
-          line("_ld" + id + " := " + in + " AND _lde" + id + ".Q;", e);
+          line(te + "(CLK := " + var + ");", e);
+          line(t + " := " + in + " AND " + te + ".Q;", e);
         } else {
-          line("_ld" + id + " := " + in + (negated ? " AND NOT " : " AND ") + var + ";", e);
+          line(t + " := " + in + (negated ? " AND NOT " : " AND ") + var + ";", e);
         }
         return true;
       }
-      line("_ld" + id + " := " + in + ";", e);
+      line(t + " := " + in + ";", e);
       const std::string storage = e.n.attribute("storage").value();
       if (!trig.empty()) {
-        line("_lde" + id + "(CLK := _ld" + id + ");", e);
-        line(var + " := _lde" + id + ".Q;", e);
+        line(te + "(CLK := " + t + ");", e);
+        line(var + " := " + te + ".Q;", e);
       } else if (storage == "set") {
-        line("IF _ld" + id + " THEN " + var + " := TRUE; END_IF;", e);
+        line("IF " + t + " THEN " + var + " := TRUE; END_IF;", e);
       } else if (storage == "reset") {
-        line("IF _ld" + id + " THEN " + var + " := FALSE; END_IF;", e);
+        line("IF " + t + " THEN " + var + " := FALSE; END_IF;", e);
       } else {
-        line(var + " := " + (negated ? "NOT _ld" : "_ld") + id + ";", e);
+        line(var + " := " + (negated ? "NOT " : "") + t + ";", e);
       }
       return true;
     }
     if (e.kind == "outVariable" || e.kind == "inOutVariable") {
-      const std::string target = expression(e);
+      const std::string target = e.target.empty() ? expression(e) : e.target;
       if (target.empty()) return fail(e.n, "<" + e.kind + "> has no <expression>");
       if (e.inputs.empty() || e.inputs.front().from.empty()) return true;
       const bool negated = e.n.attribute("negated").as_bool();
       if (const Element* f = enabled_function(e.inputs.front())) {
         // target := F(EN := en, ..., ENO => _ldenoN): with EN FALSE the target keeps its value.
         std::string en, args;
-        if (negated) return fail(e.n, "a negated output of function " + type_of(*f) + " with EN: plcfi cannot assign it under EN");
         if (!enable(*f, &en) || !arguments(*f, true, &args)) return false;
         flush_pending(e);
         enos_.insert(f->id);
-        line(target + " := " + type_of(*f) + "(EN := " + en + (args.empty() ? "" : ", " + args) + ", ENO => _ldeno" +
-                 std::to_string(f->id) + ");",
+        line(target + " := " + type_of(*f) + "(EN := " + en + (args.empty() ? "" : ", " + args) + ", ENO => " + nm("eno", f->id) + ");",
              e);
         return true;
       }
@@ -496,7 +534,7 @@ class Translator {
     auto it = by_id_.find(in.from.front().ref);
     if (it == by_id_.end()) return nullptr;
     const Element& f = elements_[it->second];
-    if (f.kind != "block" || !inst_of(f).empty()) return nullptr;
+    if (f.kind != "block" || !inst_of(f).empty() || held_.count(f.id)) return nullptr;
     for (const auto& x : f.inputs)
       if (x.formal == "EN" && !x.from.empty()) return &f;
     return nullptr;
@@ -513,6 +551,16 @@ class Translator {
   bool block(const Element& e) {
     if (type_of(e).empty()) return fail(e.n, "<block> has no typeName");
     const std::string inst = inst_of(e);
+    if (held_.count(e.id)) {
+      std::string en, args;
+      if (!enable(e, &en) || !arguments(e, true, &args)) return false;
+      flush_pending(e);
+      enos_.insert(e.id);
+      line(nm("v", e.id) + " := " + type_of(e) + "(EN := " + (en.empty() ? "TRUE" : en) +
+               (args.empty() ? "" : ", " + args) + ", ENO => " + nm("eno", e.id) + ");",
+           e);
+      return true;
+    }
     if (inst.empty() && read_.count(e.id)) return true;  // a value, written where it is read
     std::string en, args;
     if (!enable(e, &en) || !arguments(e, true, &args)) return false;
@@ -523,12 +571,70 @@ class Translator {
     }
     if (en.empty()) {
       line(inst + "(" + args + ");", e);
-      if (enos_.count(e.id)) line("_ldeno" + std::to_string(e.id) + " := TRUE;", e);
+      if (enos_.count(e.id)) line(nm("eno", e.id) + " := TRUE;", e);
     } else {
       enos_.insert(e.id);
-      line(inst + "(EN := " + en + (args.empty() ? "" : ", " + args) + ", ENO => _ldeno" + std::to_string(e.id) + ");", e);
+      line(inst + "(EN := " + en + (args.empty() ? "" : ", " + args) + ", ENO => " + nm("eno", e.id) + ");", e);
     }
     return true;
+  }
+
+  // The hidden name of kind `kind` ("" a contact's or coil's power flow, "e" an edge
+  // detector, "eno" an ENO, "v" a held function value) of element `id`.
+  std::string nm(const char* kind, long id) const { return std::string("_ld") + kind + tag_ + std::to_string(id); }
+
+  // A transition condition (cond_): with a root, only the elements the root's value
+  // depends on, and an output variable assigning that value to the target; without one,
+  // the whole network, whose coils and output variables of the transition's name set the
+  // target instead.
+  bool condition() {
+    if (!cond_->root) {
+      bool any = false;
+      for (Element& e : elements_) {
+        if (e.kind != "coil" && e.kind != "outVariable") continue;
+        std::string v = trimmed(child(e.n, e.kind == "coil" ? "variable" : "expression").text().get());
+        if (!iequal(v, cond_->name)) continue;
+        e.target = cond_->target;
+        any = true;
+      }
+      if (!any) return fail(cond_->at, "the network of transition '" + cond_->name + "' has no coil or output variable named '" +
+                                           cond_->name + "' to give the condition");
+      return true;
+    }
+    auto root = by_id_.find(cond_->root);
+    if (root == by_id_.end())
+      return fail(cond_->at, "the condition is connected to localId " + std::to_string(cond_->root) + ", which is not in the chart");
+    std::set<long> cone;
+    std::vector<long> todo{cond_->root};
+    while (!todo.empty()) {
+      const long id = todo.back();
+      todo.pop_back();
+      auto it = by_id_.find(id);
+      if (it == by_id_.end() || !cone.insert(id).second) continue;
+      for (long d : depends(elements_[it->second])) todo.push_back(d);
+    }
+    std::vector<Element> kept;
+    for (Element& e : elements_)
+      if (cone.count(e.id)) kept.push_back(std::move(e));
+    elements_ = std::move(kept);
+    Element out;
+    out.n = cond_->at;
+    out.kind = "outVariable";
+    out.order = elements_.size();
+    out.target = cond_->target;
+    for (const Element& e : elements_) out.id = std::max(out.id, e.id + 1);
+    out.inputs.push_back(Input{"", false, {Conn{cond_->root, cond_->formal}}, ""});
+    elements_.push_back(std::move(out));
+    by_id_.clear();
+    for (size_t i = 0; i < elements_.size(); ++i) by_id_[elements_[i].id] = i;
+    read_.insert(cond_->root);
+    return true;
+  }
+
+  static bool iequal(const std::string& a, const std::string& b) {
+    return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+             return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+           });
   }
 
   static constexpr int kMaxDepth = 256;
@@ -539,12 +645,16 @@ class Translator {
   bool instances_;
   LdTranslation* out_;
   LdError* err_;
+  const LdCondition* cond_;
+  std::string tag_;  // inserted into hidden names (nm), unique per condition of a chart
   std::vector<Element> elements_;
   std::map<long, size_t> by_id_;
   std::map<std::string, long> connectors_;
   std::vector<long> temps_;
   std::set<long> read_;                                        // elements some input is connected to
   std::set<long> enos_;                                        // blocks whose ENO is read
+  std::set<long> eno_read_;                                    // blocks an input reads the ENO of
+  std::set<long> held_;                                        // function boxes held in _ldv<id> (see collect)
   std::vector<std::pair<std::string, std::string>> edge_inputs_;  // edge-sensing inputs: name, type
   std::vector<std::string> pending_;                           // their calls, before the next statement
   std::map<long, std::string> edges_;
@@ -555,6 +665,12 @@ class Translator {
 bool ld_to_st(const pugi::xml_node& ld, const std::string& what, bool instances, LdTranslation* out, LdError* err) {
   Translator t(what, is(ld, "FBD"), instances, out, err);
   return t.run(ld);
+}
+
+bool ld_condition_to_st(const pugi::xml_node& network, const std::string& what, bool instances, const LdCondition& cond,
+                        LdTranslation* out, LdError* err) {
+  Translator t(what, is(network, "FBD"), instances, out, err, &cond);
+  return t.run(network);
 }
 
 }  // namespace plcfi::st

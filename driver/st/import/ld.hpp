@@ -12,8 +12,11 @@
 // falling edge); coils (plain, negated, set, reset, rising and falling edge); function and
 // function block calls (<block>; EN/ENO as ST has them; negated inputs and outputs; edges
 // on function block inputs); input (negated), output (negated) and in-out variables;
-// connectors and continuations; comments. A function's value is written where it is used;
-// one with EN connected must feed an output variable (assigned under EN). Labels divide
+// connectors and continuations; comments. A function's value is written where it is used.
+// A function with EN connected: an output variable wired to it alone is assigned under EN
+// (with EN FALSE it keeps its value); a value other boxes read is held in a hidden
+// temporary, evaluated once in its place, worth the result type's initial value with EN
+// FALSE (as MATIEC computes it); its ENO can be read like a block's. Labels divide
 // the body into networks (each ordered on its own); a jump or a return is taken when the
 // power flow or the BOOL connected to it is TRUE. Anything else is an error naming the
 // element.
@@ -47,5 +50,23 @@ struct LdError {
 // POU may hold FB instances (edges need R_TRIG/F_TRIG); false for a FUNCTION. False, with
 // *err, at the first element that cannot be translated.
 bool ld_to_st(const pugi::xml_node& ld, const std::string& what, bool instances, LdTranslation* out, LdError* err);
+
+// A transition condition of an SFC chart drawn in LD or FBD, translated to statements that
+// set the BOOL `target`.
+struct LdCondition {
+  // Drawn beside the chart (the transition's <condition><connectionPointIn>): `root` is the
+  // element the transition is connected to (`formal` its output), `network` the <SFC>
+  // element; only the elements the root's value depends on are translated.
+  long root = 0;
+  std::string formal;
+  // A network of its own (an <inline> or a named transition's body): `root` 0; the coils
+  // and output variables named `name` set the target.
+  std::string name;
+  std::string target;
+  pugi::xml_node at;  // the transition, for diagnostics
+  std::string tag;    // inserted into the network's hidden names, unique in the POU
+};
+bool ld_condition_to_st(const pugi::xml_node& network, const std::string& what, bool instances, const LdCondition& cond,
+                        LdTranslation* out, LdError* err);
 
 }  // namespace plcfi::st

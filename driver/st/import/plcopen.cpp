@@ -290,6 +290,7 @@ class Importer {
     o.line = l.line;
     o.col = l.col;
     o.exact_columns = false;
+    o.generated = true;
     return o;
   }
   // A synthesized line pointing at element n.
@@ -696,6 +697,17 @@ class Importer {
       if (!ld_to_st(ld_body, what, keyword != "FUNCTION", &ld, &err)) return error(err.code.c_str(), err.at, err.message);
       for (const auto& v : ld.vars) line(v.text, v.at);
     }
+    // An SFC body becomes textual SFC (import/sfc.hpp); the POU's <actions> and
+    // <transitions> are the chart's and go into it. Its conditions drawn in LD or FBD
+    // bring variables, which come first.
+    pugi::xml_node sfc_body = child(child(p, "body"), "SFC");
+    std::vector<SfcPiece> chart;
+    if (sfc_body && !ld_body) {
+      std::vector<SfcPiece> chart_vars;
+      SfcError err;
+      if (!sfc_to_text(sfc_body, p, what, &chart, &chart_vars, &err)) return error(err.code.c_str(), err.at, err.message);
+      for (const SfcPiece& v : chart_vars) line(v.text, v.at);
+    }
     for (auto data : children(child(p, "addData"), "data")) {
       std::string_view dn = data.attribute("name").value();
       for (auto item : data.children()) {
@@ -705,17 +717,11 @@ class Importer {
         else if (dn.ends_with("/action") && (is(item, "Action") || is(item, "action"))) action(item, what);
       }
     }
-    // An SFC body becomes textual SFC (import/sfc.hpp); the POU's <actions> and
-    // <transitions> are the chart's and go into it.
-    pugi::xml_node sfc_body = child(child(p, "body"), "SFC");
     if (!sfc_body)
       for (auto a : children(child(p, "actions"), "action")) action(a, what);
     if (ld_body) {
       for (const auto& st : ld.body) line(st.text, st.at);
     } else if (sfc_body) {
-      std::vector<SfcPiece> chart;
-      SfcError err;
-      if (!sfc_to_text(sfc_body, p, what, &chart, &err)) return error(err.code.c_str(), err.at, err.message);
       for (const SfcPiece& piece : chart) {
         if (!piece.copy) {
           line(piece.text, piece.at);

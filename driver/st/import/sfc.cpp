@@ -1,5 +1,6 @@
 // PLCopen XML SFC to textual SFC; see sfc.hpp.
 #include "import/sfc.hpp"
+#include "import/ld.hpp"
 #include "import/xml_nodes.hpp"
 
 #include <cstdlib>
@@ -18,6 +19,7 @@ using xml::local_name;
 // Graph walks are bounded: a chart whose connections form a cycle without a step (a
 // malformed file) ends in an error, not a hang.
 constexpr int kMaxWalk = 256;
+constexpr long kMaxVisits = 1 << 20;  // all walks of a chart: diamonds of divergences cannot blow up
 constexpr int kMaxNesting = 64;
 
 std::string all_text(const pugi::xml_node& n, int depth) {
@@ -48,10 +50,12 @@ struct Node {
 
 class Translator {
  public:
-  Translator(const pugi::xml_node& pou, const std::string& what, std::vector<SfcPiece>* out, SfcError* err)
-      : pou_(pou), what_(what), out_(out), err_(err) {}
+  Translator(const pugi::xml_node& pou, const std::string& what, std::vector<SfcPiece>* out, std::vector<SfcPiece>* vars,
+             SfcError* err)
+      : pou_(pou), what_(what), out_(out), vars_(vars), err_(err) {}
 
   bool run(const pugi::xml_node& sfc) {
+    sfc_ = sfc;
     if (!collect(sfc)) return false;
     // Steps first, in document order, each with its action associations.
     for (long id : order_) {
@@ -96,6 +100,12 @@ class Translator {
       if (e.type() != pugi::node_element) continue;
       const std::string kind(local_name(e));
       if (kind == "comment" || kind == "addData" || kind == "documentation") continue;
+      // LD and FBD elements drawn beside the chart: the conditions connected to them
+      // translate them (network_condition).
+      static const std::set<std::string> kNetwork = {"leftPowerRail", "rightPowerRail", "contact", "coil", "block",
+                                                      "inVariable", "outVariable", "inOutVariable", "connector",
+                                                      "continuation"};
+      if (kNetwork.count(kind)) continue;
       static const std::set<std::string> kKnown = {"step", "transition", "selectionDivergence", "selectionConvergence",
                                                     "simultaneousDivergence", "simultaneousConvergence", "jumpStep",
                                                     "actionBlock", "macroStep"};
@@ -165,7 +175,8 @@ class Translator {
 
   // The steps a transition comes from: walk back through divergences and convergences.
   bool steps_before(long id, std::vector<std::string>* out, int depth) {
-    if (depth > kMaxWalk) return fail("ST606", nodes_[id].n, what_ + ": the chart's connections form a cycle without a step");
+    if (depth > kMaxWalk || ++visits_ > kMaxVisits)
+      return fail("ST606", nodes_[id].n, what_ + ": the chart's connections form a cycle without a step");
     const Node& n = nodes_[id];
     if (n.kind == "step") {
       out->push_back(n.n.attribute("name").value());
@@ -180,7 +191,8 @@ class Translator {
 
   // The steps a transition leads to: walk forward through divergences, convergences and jumps.
   bool steps_after(long id, std::vector<std::string>* out, int depth) {
-    if (depth > kMaxWalk) return fail("ST606", nodes_[id].n, what_ + ": the chart's connections form a cycle without a step");
+    if (depth > kMaxWalk || ++visits_ > kMaxVisits)
+      return fail("ST606", nodes_[id].n, what_ + ": the chart's connections form a cycle without a step");
     for (long s : nodes_[id].succs) {
       const Node& n = nodes_[s];
       if (n.kind == "step") {
@@ -219,14 +231,30 @@ class Translator {
     pugi::xml_node cond = child(t.n, "condition");
     if (pugi::xml_node in = child(cond, "inline")) {
       pugi::xml_node st = child(in, "ST");
-      if (!st) return fail("ST606", in, what_ + ": a transition condition drawn in LD or FBD is not supported; write it in ST");
+      if (pugi::xml_node il = child(in, "IL")) return il_condition(head, t.n, il);
+      if (pugi::xml_node net = network(in)) {
+        LdCondition c;
+        c.name = trimmed(in.attribute("name").value());
+        if (c.name.empty())
+          return fail("ST606", in, what_ + ": an inline condition drawn in LD or FBD needs a name (its coil or output "
+                                           "variable of that name gives the condition)");
+        return network_condition(head, id, net, std::move(c));
+      }
+      if (!st) return fail("ST606", in, what_ + ": an inline transition condition must be ST, IL, LD or FBD");
       out_->push_back(SfcPiece{head + " := ", t.n, st, ";"});
     } else if (pugi::xml_node ref = child(cond, "reference")) {
       const std::string name = ref.attribute("name").value();
       pugi::xml_node tr = named(child(pou_, "transitions"), "transition", name);
       if (!tr) return fail("ST606", ref, what_ + ": the transition '" + name + "' it refers to is not in <transitions>");
-      pugi::xml_node st = child(child(tr, "body"), "ST");
-      if (!st) return fail("ST606", tr, what_ + ": transition '" + name + "' needs an ST body (LD, FBD and IL are not supported)");
+      pugi::xml_node tbody = child(tr, "body");
+      if (pugi::xml_node il = child(tbody, "IL")) return il_condition(head, tr, il);
+      if (pugi::xml_node net = network(tbody)) {
+        LdCondition c;
+        c.name = name;
+        return network_condition(head, id, net, std::move(c));
+      }
+      pugi::xml_node st = child(tbody, "ST");
+      if (!st) return fail("ST606", tr, what_ + ": transition '" + name + "' needs a body in ST, IL, LD or FBD");
       // Its body is ":= condition;" as Beremiz writes it, or the bare condition.
       std::string body = trimmed(all_text(st, 0));
       if (body.rfind(":=", 0) == 0) {
@@ -234,16 +262,60 @@ class Translator {
       } else {
         out_->push_back(SfcPiece{head + " := ", tr, st, !body.empty() && body.back() == ';' ? "" : ";"});
       }
+    } else if (pugi::xml_node point = child(cond, "connectionPointIn")) {
+      // Drawn beside the chart: the value of the element the condition is connected to.
+      std::vector<pugi::xml_node> links = children(point, "connection");
+      if (links.size() != 1)
+        return fail("ST606", point, what_ + ": a transition condition must be connected to exactly one element");
+      LdCondition c;
+      char* end = nullptr;
+      c.root = std::strtol(links[0].attribute("refLocalId").value(), &end, 10);
+      if (!end || *end || !c.root) return fail("ST606", links[0], what_ + ": a condition connection without a numeric refLocalId");
+      c.formal = links[0].attribute("formalParameter").value();
+      return network_condition(head, id, sfc_, std::move(c));
     } else {
-      return fail("ST606", t.n, what_ + ": a transition without a condition (an inline ST expression or a reference)");
+      return fail("ST606", t.n, what_ + ": a transition without a condition (inline, a reference or a connection)");
     }
     text("END_TRANSITION", t.n);
     return true;
   }
 
+  static pugi::xml_node network(const pugi::xml_node& holder) {
+    if (pugi::xml_node ld = child(holder, "LD")) return ld;
+    return child(holder, "FBD");
+  }
+
+  // A condition in IL: the instructions' final current result.
+  bool il_condition(const std::string& head, const pugi::xml_node& at, const pugi::xml_node& il) {
+    text(head + " :", at);
+    out_->push_back(SfcPiece{"", at, il, ""});
+    text("END_TRANSITION", at);
+    return true;
+  }
+
+  // A condition drawn in LD or FBD: the network's statements set a hidden BOOL, the
+  // transition's name in the generated text (parse_sfc.cpp), which is the condition.
+  bool network_condition(const std::string& head, long id, const pugi::xml_node& net, LdCondition c) {
+    const std::string tag = "t" + std::to_string(id) + "_";
+    c.target = "_sfc" + tag + "cond";
+    c.tag = tag;
+    c.at = nodes_[id].n;
+    LdTranslation tr;
+    LdError err;
+    if (!ld_condition_to_st(net, what_, true, c, &tr, &err)) return fail(err.code.c_str(), err.at, err.message);
+    for (const LdLine& v : tr.vars) vars_->push_back(SfcPiece{v.text, v.at, {}, ""});
+    // TRANSITION name (PRIORITY ...) FROM ...: the name goes right after the keyword.
+    text("TRANSITION " + c.target + head.substr(std::string("TRANSITION").size()) + " :", c.at);
+    for (const LdLine& l : tr.body) text("  " + l.text, l.at);
+    text("END_TRANSITION", c.at);
+    return true;
+  }
+
   pugi::xml_node pou_;
+  pugi::xml_node sfc_;
   std::string what_;
   std::vector<SfcPiece>* out_;
+  std::vector<SfcPiece>* vars_;
   SfcError* err_;
   std::map<long, Node> nodes_;
   std::vector<long> order_;  // document order
@@ -255,13 +327,14 @@ class Translator {
   std::vector<Action> actions_;  // ACTION bodies in order of first association
   std::set<std::string> used_;
   int inline_count_ = 0;
+  long visits_ = 0;
 };
 
 }  // namespace
 
 bool sfc_to_text(const pugi::xml_node& sfc, const pugi::xml_node& pou, const std::string& what,
-                 std::vector<SfcPiece>* out, SfcError* err) {
-  return Translator(pou, what, out, err).run(sfc);
+                 std::vector<SfcPiece>* out, std::vector<SfcPiece>* vars, SfcError* err) {
+  return Translator(pou, what, out, vars, err).run(sfc);
 }
 
 }  // namespace plcfi::st

@@ -8,12 +8,16 @@
 // goes TO the steps found by walking forward through simultaneous divergences, selection
 // convergences and jump steps (a jump step stands for its target).
 //
-// Supported: steps (initialStep), transitions with an inline ST condition or a reference
-// to a named transition of the POU (<transitions>, an ST body), priorities, the four
+// Supported: steps (initialStep), transitions with a condition inline (ST, IL, or a
+// network in LD or FBD whose coil or output variable of the inline's name gives it), a
+// reference to a named transition of the POU (<transitions>: an ST or IL body, or an LD or
+// FBD network setting the transition's name, as Beremiz draws them) or a connection to LD
+// or FBD elements drawn beside the chart (the value of the element connected; only the
+// elements it depends on are evaluated, when the transition is tried), priorities, the four
 // divergence/convergence elements, jump steps, action blocks whose actions reference an
 // action of the POU (<actions>, an ST body) or hold inline ST, each with its qualifier,
-// duration and indicator. A condition drawn in LD or FBD, or a body in another language,
-// is an error naming the element.
+// duration and indicator. An action body in another language than ST is an error naming
+// the element.
 #pragma once
 
 #include <string>
@@ -41,7 +45,9 @@ struct SfcError {
 // Translates the <SFC> element of `pou` (its <actions> and <transitions> supply the named
 // bodies). `what` names the POU in messages. False, with *err, on an unsupported or
 // malformed chart.
+// *vars: declaration blocks the chart needs (conditions drawn in LD or FBD), to go before
+// the body.
 bool sfc_to_text(const pugi::xml_node& sfc, const pugi::xml_node& pou, const std::string& what,
-                 std::vector<SfcPiece>* out, SfcError* err);
+                 std::vector<SfcPiece>* out, std::vector<SfcPiece>* vars, SfcError* err);
 
 }  // namespace plcfi::st

@@ -5,6 +5,7 @@
 //   association := action '(' [qualifier [',' duration]] {',' indicator} ')'
 //   TRANSITION [name] ['(' PRIORITY ':=' integer ')'] FROM steps TO steps
 //     (':=' expr ';' | ':' IL instructions) END_TRANSITION
+//   (an importer's line may give a named transition ':' ST statements that set its name)
 //   steps := name | '(' name {',' name} ')'
 //   ACTION name ':' (stmt_list | IL instructions) END_ACTION
 //
@@ -189,7 +190,18 @@ void Parser::parse_sfc_transition(SfcChart& chart) {
   } else if (ok && accept(Tok::Colon)) {
     // The condition in IL: its final current result, kept in a BOOL of the chart.
     const std::string var = "__sfc_c" + std::to_string(chart.transitions.size());
-    if (!at_il_body()) {
+    if (t.name && !at_il_body() && synthesized_line(t.loc.line)) {
+      // An importer's condition drawn in LD or FBD (import/sfc.cpp): ST statements that set
+      // the transition's (hidden) name, which holds the condition.
+      const std::string_view outer = sfc_end_;
+      sfc_end_ = "END_TRANSITION";
+      parse_stmt_list(t.condition_body, false);
+      sfc_end_ = outer;
+      auto n = std::make_unique<NameExpr>(t.loc);
+      n->name = *t.name;
+      t.condition = std::move(n);
+      t.name.reset();
+    } else if (!at_il_body()) {
       error("ST140", cur().loc, what + ": after ':' the condition is Instruction List (e.g. LD x  AND y), found " +
                                     describe(cur()) + "; an ST condition is written ':= expression;'");
     } else {

@@ -169,6 +169,12 @@ StmtPtr Parser::parse_assign_or_call() {
   if (at(Tok::Assign) || at(Tok::RefAssign)) {
     auto s = std::make_unique<AssignStmt>(loc);
     s->is_ref_assign = advance().kind == Tok::RefAssign;
+    // An importer's hidden temporary (`_ldv<N> := F(EN := ...)`, an FBD function box with
+    // EN whose value other boxes read): declared by this assignment with the type of its
+    // value, which only the compiler knows.
+    if (target->kind == ExprKind::Name && synthesized_line(loc.line) &&
+        static_cast<const NameExpr&>(*target).name.text.rfind("_ldv", 0) == 0)
+      s->declares_temp = true;
     s->lhs = std::move(target);
     size_t rhs_start = pos_;
     s->rhs = parse_expr();

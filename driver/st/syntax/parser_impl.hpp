@@ -148,7 +148,7 @@ class Parser {
   // A line an importer wrote itself (an LD/FBD network's jump or label), not user text.
   bool synthesized_line(uint32_t line) const {
     const auto& origins = sm_.file(file_).origins;
-    return line >= 1 && line <= origins.size() && !origins[line - 1].where.exact_columns;
+    return line >= 1 && line <= origins.size() && origins[line - 1].where.generated;
   }
 
   // ------------------------------------------------------------ diagnostics

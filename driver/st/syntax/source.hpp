@@ -29,6 +29,10 @@ struct LineOrigin {
   // operator spelled another way); empty: the same columns.
   std::vector<uint32_t> col_map;
   bool exact_columns = true;  // false: every column of the line points at `col`
+  // An importer wrote this line itself (an LD/FBD network's statement, jump or label), as
+  // opposed to user text copied from the file: it may use what only importers write
+  // (jumps in any dialect, hidden temporaries; see Parser::synthesized_line).
+  bool generated = false;
   std::string context;        // appended to the message, in parentheses ("in the precondition of ...")
 };
 
