@@ -148,7 +148,7 @@ void Compiler::declare_labels(const StmtList& list) {
     auto [it, fresh] = b_->goto_labels.try_emplace(canon(l.name.text), std::pair{new_label(), l.name.loc});
     if (!fresh) {
       const SourceLoc first = it->second.second;
-      diags_.error("ST244", l.name.loc, "label '" + l.name.text + "' is declared twice (first at line " +
+      diags_.error("ST244", l.name.loc, "label '" + l.shown() + "' is declared twice (first at line " +
                                             std::to_string(first.line) + ")");
     }
   }
@@ -156,12 +156,12 @@ void Compiler::declare_labels(const StmtList& list) {
 
 void Compiler::label_stmt(const LabelStmt& s) {
   if (!s.from_il && opt_.dialect == Dialect::Iec) {
-    diags_.error("ST241", s.loc, "a label (" + s.name.text + ":) is CODESYS ST, not IEC 61131-3: use IF, CASE or a loop, or --dialect codesys");
+    diags_.error("ST241", s.loc, "a label (" + s.shown() + ":) is CODESYS ST, not IEC 61131-3: use IF, CASE or a loop, or --dialect codesys");
     return;
   }
   auto it = b_->goto_labels.find(canon(s.name.text));
   if (b_->stmt_depth != 1 || it == b_->goto_labels.end()) {
-    diags_.error("ST244", s.name.loc, "label '" + s.name.text +
+    diags_.error("ST244", s.name.loc, "label '" + s.shown() +
                                           "' must stand at the outer level of the body, not inside IF, CASE or a loop (a jump may leave a block, not enter one)");
     return;
   }
@@ -176,7 +176,7 @@ void Compiler::jump_stmt(const JumpStmt& s) {
   }
   auto it = b_->goto_labels.find(canon(s.label.text));
   if (it == b_->goto_labels.end()) {
-    diags_.error("ST244", s.label.loc, "JMP to '" + s.label.text + "', a label the body does not have");
+    diags_.error("ST244", s.label.loc, "JMP to '" + s.shown() + "', a label the body does not have");
     return;
   }
   const Label target = it->second.first;

@@ -4,6 +4,7 @@
 // iequals()/canon().
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -379,12 +380,18 @@ struct LabelStmt : Stmt {
   Ident name;
   // Written in Instruction List or generated from an LD/FBD jump (IEC), not ST (CODESYS only).
   bool from_il = false;
+  // Characters of name.text a lowering put before the user's name (an SFC action's labels
+  // are its own): messages show the rest.
+  size_t hidden_prefix = 0;
+  std::string shown() const { return name.text.substr(std::min(hidden_prefix, name.text.size())); }
 };
 
 struct JumpStmt : Stmt {
   explicit JumpStmt(SourceLoc l) : Stmt(StmtKind::Jump, l) {}
   Ident label;
   bool from_il = false;
+  size_t hidden_prefix = 0;  // as LabelStmt's
+  std::string shown() const { return label.text.substr(std::min(hidden_prefix, label.text.size())); }
 };
 
 // ---------------------------------------------------------------- SFC

@@ -115,6 +115,7 @@ ExprPtr any_active(const At& at, const std::vector<std::string>& steps) {
 
 constexpr const char* kChart = "__SFC";
 constexpr const char* kDt = "__sfc_dt";
+constexpr const char* kNow = "__sfc_now";  // the clock, read once per scan
 
 // One action and what the steps associate with it.
 struct ActionUse {
@@ -151,6 +152,7 @@ class Lowering {
     for (const ActionUse& a : actions_) vars.decls.push_back(At{a.loc}.decl(a.var, "__SFC_ACTION", VarSection::Var));
     vars.decls.push_back(at.decl(kChart, "__SFC_CHART", VarSection::Var));
     temps.decls.push_back(at.decl(kDt, "TIME", VarSection::Temp));
+    temps.decls.push_back(at.decl(kNow, "TIME", VarSection::Temp));
     for (size_t i = 0; i < chart_.transitions.size(); ++i) {
       const SfcTransition& t = chart_.transitions[i];
       temps.decls.push_back(At{t.loc}.decl(fired(i), "BOOL", VarSection::Temp));
@@ -161,9 +163,10 @@ class Lowering {
     pou_.var_blocks.push_back(std::move(temps));
 
     StmtList& body = pou_.body;
+    body.push_back(at.assign(at.name(kNow), at.now()));
     body.push_back(at.assign(at.name(kDt), at.zero_time()));
     StmtList evolve;
-    evolve.push_back(at.assign(at.name(kDt), at.bin(BinaryOp::Sub, at.now(), at.field(kChart, "last"))));
+    evolve.push_back(at.assign(at.name(kDt), at.bin(BinaryOp::Sub, at.name(kNow), at.field(kChart, "last"))));
     for (const SfcStep& s : chart_.steps) {
       const At st{s.loc};
       evolve.push_back(st.when(st.field(s.name.text, "X"),
@@ -174,7 +177,7 @@ class Lowering {
     lower_transitions(evolve);
     body.push_back(at.when(at.field(kChart, "started"), std::move(evolve), std::nullopt, "chart evolves"));
     body.push_back(at.assign(at.field(kChart, "started"), at.boolean(true)));
-    body.push_back(at.assign(at.field(kChart, "last"), at.now()));
+    body.push_back(at.assign(at.field(kChart, "last"), at.name(kNow)));
     for (const ActionUse& a : actions_) lower_control(a, body);
     for (const ActionUse& a : actions_) {
       if (a.bool_var.empty()) continue;
@@ -272,9 +275,11 @@ class Lowering {
         s = jump(end, s->loc);
       } else if (s->kind == StmtKind::Label) {
         auto& l = static_cast<LabelStmt&>(*s);
+        l.hidden_prefix = ("__sfc_" + action + "_").size();
         l.name.text = "__sfc_" + action + "_" + l.name.text;
       } else if (s->kind == StmtKind::Jump && static_cast<JumpStmt&>(*s).label.text != end) {
         auto& j = static_cast<JumpStmt&>(*s);
+        j.hidden_prefix = ("__sfc_" + action + "_").size();
         j.label.text = "__sfc_" + action + "_" + j.label.text;
       }
       for_each_list(*s, [&](StmtList& l) { rewrite(l, action, end); });
@@ -429,11 +434,13 @@ class Lowering {
       auto it = a.steps.find(q);
       return it == a.steps.end() ? nullptr : &it->second;
     };
+    // Without an R association the reset is constant FALSE: no variable, no test.
     const bool has_r = steps("R") != nullptr;
-    out.push_back(at.assign(f("__r"), has_r ? any_active(at, *steps("R")) : at.boolean(false)));
+    if (has_r) out.push_back(at.assign(f("__r"), any_active(at, *steps("R"))));
+    const auto unreset = [&](ExprPtr e) { return has_r ? at.and_(at.not_(f("__r")), std::move(e)) : std::move(e); };
     ExprPtr q = steps("N") ? any_active(at, *steps("N")) : at.boolean(false);
     if (const auto* s = steps("S")) {  // S_FF: RS with the reset dominant
-      out.push_back(at.assign(f("__s"), at.and_(at.not_(f("__r")), at.or_(f("__s"), any_active(at, *s)))));
+      out.push_back(at.assign(f("__s"), unreset(at.or_(f("__s"), any_active(at, *s)))));
       q = at.or_(std::move(q), f("__s"));
     }
     if (const auto* p = steps("P")) {  // P_TRIG: the rising edge of the association
@@ -447,7 +454,7 @@ class Lowering {
       q = at.or_(std::move(q), f("__p0"));
     }
     if (a.timed) q = at.or_(std::move(q), lower_timed(a, out));
-    out.push_back(at.assign(f("Q"), at.and_(at.not_(f("__r")), std::move(q))));
+    out.push_back(at.assign(f("Q"), unreset(std::move(q))));
     out.push_back(at.assign(f("A"), at.or_(f("Q"), f("__qprev"))));
     out.push_back(at.assign(f("__qprev"), f("Q")));
   }
@@ -459,8 +466,10 @@ class Lowering {
     const At at{as.loc};
     const auto f = [&](const char* name) { return at.field(a.var, name); };
     const std::string& q = as.qualifier;
+    const bool has_r = a.steps.count("R") > 0;
     const auto flip_flop = [&](ExprPtr set) {  // RS, reset dominant
-      out.push_back(at.assign(f("__ff"), at.and_(at.not_(f("__r")), at.or_(f("__ff"), std::move(set)))));
+      ExprPtr v = at.or_(f("__ff"), std::move(set));
+      out.push_back(at.assign(f("__ff"), has_r ? at.and_(at.not_(f("__r")), std::move(v)) : std::move(v)));
     };
     // The timer's input.
     if (q == "SD" || q == "SL") flip_flop(at.field(a.timed_step, "X"));
