@@ -565,6 +565,7 @@ class Translator {
     std::string en, args;
     if (!enable(e, &en) || !arguments(e, true, &args)) return false;
     flush_pending(e);
+    if (!inst.empty()) out_->instances.push_back(inst);
     if (inst.empty()) {  // a function nobody reads still runs (its in-out parameters, its effects)
       line(type_of(e) + "(" + (en.empty() ? args : "EN := " + en + (args.empty() ? "" : ", " + args)) + ");", e);
       return true;

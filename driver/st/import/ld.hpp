@@ -38,6 +38,7 @@ struct LdLine {
 struct LdTranslation {
   std::vector<LdLine> vars;  // declaration blocks the body needs (before the body)
   std::vector<LdLine> body;  // the statements
+  std::vector<std::string> instances;  // the function block instances the statements call
 };
 
 struct LdError {

@@ -303,6 +303,16 @@ class Translator {
     LdTranslation tr;
     LdError err;
     if (!ld_condition_to_st(net, what_, true, c, &tr, &err)) return fail(err.code.c_str(), err.at, err.message);
+    // Drawn beside the chart, one function block may feed two conditions: each would call
+    // it, twice in a scan when both transitions are tried (an edge or a count lost).
+    for (const std::string& inst : tr.instances) {
+      auto [it, fresh] = called_.emplace(inst, id);
+      if (!fresh && it->second != id)
+        return fail("ST606", c.at, what_ + ": the function block instance '" + inst + "' feeds the conditions of two "
+                                           "transitions (localId " + std::to_string(it->second) + " and " +
+                                           std::to_string(id) + "): each would call it in the same scan; let one "
+                                           "condition call it and the other read a variable it sets");
+    }
     for (const LdLine& v : tr.vars) vars_->push_back(SfcPiece{v.text, v.at, {}, ""});
     // TRANSITION name (PRIORITY ...) FROM ...: the name goes right after the keyword.
     text("TRANSITION " + c.target + head.substr(std::string("TRANSITION").size()) + " :", c.at);
@@ -328,6 +338,7 @@ class Translator {
   std::set<std::string> used_;
   int inline_count_ = 0;
   long visits_ = 0;
+  std::map<std::string, long> called_;  // FB instance -> the transition whose condition calls it
 };
 
 }  // namespace
