@@ -16,6 +16,7 @@
 #include "campaign/explore.hpp"
 #include "campaign/generate.hpp"
 #include "campaign/parallel.hpp"
+#include "campaign/safety.hpp"
 #include "commands.hpp"
 #include "options.hpp"
 #include "coverage_opts.hpp"
@@ -476,6 +477,22 @@ int cmd_campaign(const std::vector<std::string>& args) {
   }
   for (const auto& l : io_report) std::cout << "  " << l << "\n";
   if (cb.spec.explore.enabled && !print_suggestions(cb, res, out)) return 2;
+  // Safety evidence, only when the FMEA gives failure rates (else nothing changes).
+  std::optional<report::SafetyReport> safety;
+  if (campaign::wants_safety_evidence(c)) {
+    safety = campaign::safety_evidence(cb, res.executions, res.not_reached, res.pending, opt.vcd);
+    for (const auto& [name, text] : {std::pair{"safety.json", report::safety_json(*safety)},
+                                     {"traceability.csv", report::traceability_csv(*safety)}}) {
+      std::string path = (std::filesystem::path(out) / name).string();
+      std::ofstream f(path, std::ios::binary);
+      f << text;
+      if (!f) {
+        std::cerr << "plcfi campaign: " << path << ": cannot write\n";
+        return 2;
+      }
+    }
+    std::cout << report::safety_text(*safety, out);
+  }
 
   if (vm.count("junit")) {
     report::JunitSuite suite;
@@ -506,6 +523,8 @@ int cmd_campaign(const std::vector<std::string>& args) {
     suite.properties.emplace_back("plant", cb.spec.plant);
     for (size_t i = 0; i < io_report.size(); ++i) suite.properties.emplace_back(fmt::format("io_{}", i), io_report[i]);
     if (res.interrupted) suite.properties.emplace_back("incomplete", res.end_reason);
+    if (safety)
+      for (auto& prop : report::safety_junit_properties(*safety)) suite.properties.push_back(std::move(prop));
     for (size_t i : res.pending) {
       const auto& tc = cb.cases[i];
       report::JunitCase jc;
@@ -532,7 +551,9 @@ int cmd_campaign(const std::vector<std::string>& args) {
   }
   if (vm.count("html")) {
     std::string dir = vm["html"].as<std::string>();
-    if (!report::write_html_report(html_campaign_model(cb, res, out, opt.vcd), dir, &err)) {
+    auto model = html_campaign_model(cb, res, out, opt.vcd);
+    model.safety = safety;
+    if (!report::write_html_report(model, dir, &err)) {
       std::cerr << "plcfi campaign: " << err << "\n";
       return 2;
     }
