@@ -220,10 +220,13 @@ bool parse_safety_json(const std::string& text, const std::string& path, SafetyR
   if (auto it = j.find("campaign"); it != j.end() && it->is_string()) r.campaign = it->get<std::string>();
   auto fns = j.find("safety_functions");
   if (fns == j.end() || !fns->is_array()) return bad("no safety_functions list");
+  // Milliseconds to ns; null, negative or beyond a year (no reaction of a scan program)
+  // reads as "none" rather than overflowing.
   auto ns_of = [](const Json& v) -> int64_t {
-    if (v.is_number_integer()) return v.get<int64_t>() * 1'000'000;
-    if (v.is_number()) return static_cast<int64_t>(std::llround(v.get<double>() * 1e6));
-    return -1;
+    if (!v.is_number()) return -1;
+    double ms = v.get<double>();
+    if (!(ms >= 0 && ms <= 3.2e10)) return -1;
+    return static_cast<int64_t>(std::llround(ms * 1e6));
   };
   for (const auto& f : *fns) {
     if (!f.is_object() || !f.contains("id") || !f["id"].is_string()) return bad("a safety function without an id");
@@ -248,7 +251,7 @@ bool parse_safety_json(const std::string& text, const std::string& path, SafetyR
       if (!u.is_object() || !u.contains("case") || !u["case"].is_string()) return bad("an unassessed failure mode without a case");
       UnassessedMode m;
       m.case_id = u["case"].get<std::string>();
-      if (u.contains("path") && u["path"].is_number_integer()) m.path = u["path"].get<int>();
+      if (u.contains("path") && u["path"].is_number_integer()) m.path = static_cast<int>(u["path"].get<int64_t>() & 0x7fffffff);
       r.unassessed.push_back(m);
     }
   if (auto ex = j.find("executions"); ex != j.end() && ex->is_array())
@@ -258,7 +261,7 @@ bool parse_safety_json(const std::string& text, const std::string& path, SafetyR
         return bad("an execution without case, path or verdict");
       SafetyExecution x;
       x.case_id = e["case"].get<std::string>();
-      x.path = e["path"].get<int>();
+      x.path = static_cast<int>(e["path"].get<int64_t>() & 0x7fffffff);
       x.verdict = e["verdict"].get<std::string>();
       if (e.contains("fmea") && e["fmea"].is_string()) x.fmea = e["fmea"].get<std::string>();
       if (e.contains("reaction_ms")) x.reaction_ns = ns_of(e["reaction_ms"]);

@@ -7,8 +7,11 @@
 #   2. the summary's "safety evidence" section equals expected/<run>.txt (PLCFI_UPDATE_SNAPSHOTS=1
 #      rewrites them);
 #   3. JUnit carries the evidence as suite properties;
-#   4. the checker itself fails on a safety.json with a wrong DC (so the test can fail);
-#   5. the campaign without failure rates writes no safety.json and no traceability.csv.
+#   4. --baseline: the published program against the fixed one's run lists the lost PASS, the
+#      lower DC and F3 and fails with --fail-on-regression; the fixed run against itself has
+#      no change; a longer worst reaction than the baseline's fails only with the flag;
+#   5. the checker itself fails on a safety.json with a wrong DC (so the test can fail);
+#   6. the campaign without failure rates writes no safety.json and no traceability.csv.
 # usage: run.sh PLCFI SOURCE_DIR
 set -uo pipefail
 plcfi=$1
@@ -53,6 +56,27 @@ snapshot explore
 grep -q '<property name="safety.SF_stamp.dc" value="0.8929"/>' "$work/published.xml" || fail "no DC property in JUnit"
 grep -q '<property name="safety.SF_stamp.undetected" value="F3"/>' "$work/published.xml" || fail "no undetected property in JUnit"
 grep -q '<property name="safety.SF_stamp.margin_ms" value="130"/>' "$work/published.xml" || fail "no margin property in JUnit"
+
+# --baseline OLD_OUT [--fail-on-regression]
+run regressed 1 --program "$src/st_programs/stamping/stamping.st" --no-vcd --baseline "$work/fixed" --fail-on-regression
+grep -q '^3 change(s) since .*, 3 regression(s)$' "$work/regressed.txt" || { cat "$work/regressed.txt"; fail "regressed: not 3 regressions"; }
+for l in 'REGRESSION TC3 path 1: PASS -> FAIL' 'REGRESSION SF_stamp: DC 100.0 % (high) -> 89.3 % (low)' \
+         'REGRESSION SF_stamp: row F3 undetected now' 'failing (--fail-on-regression)'; do
+  grep -qF "$l" "$work/regressed.txt" || { cat "$work/regressed.txt"; fail "regressed: no line '$l'"; }
+done
+run same 0 --program "$src/st_programs/stamping/stamping_fixed.st" --no-vcd --baseline "$work/fixed" --fail-on-regression
+grep -q "^no change since $work/fixed (baseline)$" "$work/same.txt" || { cat "$work/same.txt"; fail "same: a change against itself"; }
+mkdir -p "$work/faster"
+python3 - "$work/fixed/safety.json" "$work/faster/safety.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+for f in s["safety_functions"]:
+    if f["id"] == "SF_stamp": f["worst_reaction_ms"] = 1000
+json.dump(s, open(sys.argv[2], "w"))
+PY
+run slower 0 --program "$src/st_programs/stamping/stamping_fixed.st" --no-vcd --baseline "$work/faster"
+grep -qF 'REGRESSION SF_stamp: worst reaction 1000 ms -> 1870 ms' "$work/slower.txt" || { cat "$work/slower.txt"; fail "slower: no regression of the worst reaction"; }
+run slower_fails 1 --program "$src/st_programs/stamping/stamping_fixed.st" --no-vcd --baseline "$work/faster" --fail-on-regression
 
 # The checker must see a wrong number.
 sed -i 's/"dc": 0.89[0-9]*/"dc": 0.9/' "$work/published/safety.json"
