@@ -78,13 +78,23 @@ struct FmeaRow {
   std::string fault_class;
   std::string alarm;        // alarm variable
   std::string fault_model;  // "" (default), "stuck_at(1)", or "Lifeline: model"
+  // Safety evidence (optional columns failure_rate, safety_function, dangerous): the row's
+  // failure rate in FIT (failures per 10^9 h), the safety function it threatens, and whether
+  // the failure is dangerous (a safe one counts toward the safe failure fraction). A row
+  // without a safety function (empty cell) is outside the evidence: failure_rate < 0.
+  std::string safety_function;
+  double failure_rate = -1;
+  bool dangerous = true;
   uint32_t line = 0;
-  Loc transition_loc, class_loc, alarm_loc, fault_loc;
+  Loc transition_loc, class_loc, alarm_loc, fault_loc, rate_loc;
 };
 
 struct Fmea {
   std::string path;
   std::vector<FmeaRow> rows;
+  // The header has the failure_rate column (and so safety_function): the campaign writes
+  // its safety evidence. Without it every output stays as it was before that column existed.
+  bool has_rates = false;
 };
 
 // A requirement of a fault class: EDTL formulas with the placeholders {alarm}, {start},
@@ -117,6 +127,10 @@ struct FaultClass {
   std::string id, name, text;
   int64_t reaction_time_ns = 0;
   int64_t max_duration_ns = 30'000'000'000;
+  // The process safety time (`safety_time:`): from the failure to the hazard, the budget for
+  // detection and reaction that the safety evidence measures the worst reaction against.
+  // -1: not given.
+  int64_t safety_time_ns = -1;
   std::vector<ClassRequirement> requirements;
   std::vector<Forbidden> forbidden;
   Recovery recovery;

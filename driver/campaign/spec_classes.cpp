@@ -1,5 +1,6 @@
 // The fault classes of a campaign: per class the reaction time and the EDTL requirements
-// (with {alarm}, {start}, {deadline}, {signal} placeholders) and forbidden reactions.
+// (with {alarm}, {start}, {deadline}, {signal} placeholders), forbidden reactions, the
+// recovery and the safety time the safety evidence measures reactions against.
 #include <set>
 
 #include "campaign/spec_internal.hpp"
@@ -12,7 +13,8 @@ void parse_classes(const common::YamlDoc& f, FaultClasses* out) {
   f.check_keys(f.root(), {"fault_classes"}, "a fault-class file");
   out->path = f.path();
   for (const auto& n : f.list(f.required(f.root(), "fault_classes", "a fault-class file"), "fault_classes")) {
-    f.check_keys(n, {"id", "name", "text", "reaction_time", "max_duration", "requirements", "forbidden", "recovery"},
+    f.check_keys(n, {"id", "name", "text", "reaction_time", "max_duration", "safety_time", "requirements", "forbidden",
+                  "recovery"},
                  "a fault class");
     FaultClass c;
     c.loc = loc_of(f, n);
@@ -23,6 +25,7 @@ void parse_classes(const common::YamlDoc& f, FaultClasses* out) {
     if (n["text"]) c.text = f.scalar(n["text"], "text");
     if (n["reaction_time"]) c.reaction_time_ns = f.duration(n["reaction_time"], "reaction_time");
     if (n["max_duration"]) c.max_duration_ns = f.duration(n["max_duration"], "max_duration", 1);
+    if (n["safety_time"]) c.safety_time_ns = f.duration(n["safety_time"], "safety_time", 1);
     std::set<std::string> ids;
     for (const auto& rn : f.list(f.required(n, "requirements", "a fault class"), "requirements")) {
       f.check_keys(rn, {"id", "text", "trigger", "invariant", "final", "delay", "reaction", "release"}, "a class requirement");

@@ -1,5 +1,9 @@
 // The FMEA table of a campaign (CSV as spreadsheets export it: ',' or ';', RFC 4180
-// quoting): one row per failure mode with S/O/D ratings, RPN, fault class and alarm.
+// quoting): one row per failure mode with S/O/D ratings, RPN, fault class and alarm, and
+// optionally its failure rate, safety function and whether it is dangerous.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <set>
 #include <sstream>
 
@@ -87,6 +91,41 @@ std::string lower(std::string s) {
   return s;
 }
 
+// The safety columns of one row. A row without a safety function stands outside the
+// evidence and must leave the rate and `dangerous` empty; a row with one needs its rate.
+void read_safety_columns(FmeaRow& r, const std::string& rate, const Loc& rate_at, const std::string& function,
+                         const Loc& function_at, const std::string& dangerous, const Loc& dangerous_at, char sep) {
+  r.safety_function = function;
+  r.rate_loc = rate_at;
+  if (function.empty()) {
+    if (!rate.empty())
+      throw common::InputError(function_at.str() + ": safety_function: row " + r.id + " has a failure rate but no safety function");
+    if (!dangerous.empty())
+      throw common::InputError(function_at.str() + ": safety_function: row " + r.id + " says dangerous '" + dangerous +
+                               "' but names no safety function");
+    return;
+  }
+  if (!valid_name(function))
+    throw common::InputError(function_at.str() + ": safety_function: '" + function + "' is not an identifier");
+  if (rate.empty())
+    throw common::InputError(rate_at.str() + ": failure_rate: row " + r.id + " belongs to safety function " + function +
+                             " but has no failure rate (FIT)");
+  // A spreadsheet that separates with ';' writes a decimal comma.
+  std::string text = rate;
+  if (sep == ';') std::replace(text.begin(), text.end(), ',', '.');
+  double v = 0;
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  bool digits_only = text.find_first_not_of("0123456789.eE+-") == std::string::npos;
+  if (ec != std::errc() || end != text.data() + text.size() || !digits_only || !std::isfinite(v))
+    throw common::InputError(rate_at.str() + ": failure_rate: expected a number of FIT (failures per 10^9 h), got '" + rate + "'");
+  if (v < 0) throw common::InputError(rate_at.str() + ": failure_rate: " + rate + " is negative");
+  r.failure_rate = v;
+  std::string d = lower(dangerous);
+  if (d.empty() || d == "yes") r.dangerous = true;
+  else if (d == "no") r.dangerous = false;
+  else throw common::InputError(dangerous_at.str() + ": dangerous: expected yes or no, got '" + dangerous + "'");
+}
+
 }  // namespace
 
 void parse_fmea(const std::string& path, Fmea* out) {
@@ -122,7 +161,11 @@ void parse_fmea(const std::string& path, Fmea* out) {
       {"fault_class", {"fault_class", "fault class", "class"}, true},
       {"alarm", {"alarm", "alarm message", "message", "msg"}, true},
       {"fault_model", {"fault_model", "fault model", "fault"}, false},
+      {"failure_rate", {"failure_rate", "failure rate", "fit", "lambda"}, false},
+      {"safety_function", {"safety_function", "safety function", "sf"}, false},
+      {"dangerous", {"dangerous"}, false},
   };
+  enum : size_t { kRate = 13, kFunction = 14, kDangerous = 15 };
   std::vector<int> index(columns.size(), -1);
   for (size_t h = 0; h < header.size(); ++h) {
     std::string name = lower(trim(header[h]));
@@ -138,12 +181,21 @@ void parse_fmea(const std::string& path, Fmea* out) {
         }
     if (!known)
       throw common::InputError(fmt::format("{}:1:{}: unknown column '{}' (expected id, tsd_transition, failure_mode, S, effect, cause, O, "
-                                  "detection, D, RPN, fault_class, alarm, fault_model)",
+                                  "detection, D, RPN, fault_class, alarm, fault_model, failure_rate, safety_function, dangerous)",
                                   path, cols[h], header[h]));
   }
   for (size_t c = 0; c < columns.size(); ++c)
     if (columns[c].required && index[c] < 0)
       throw common::InputError(fmt::format("{}:1:1: the header lacks the column '{}'", path, columns[c].names.front()));
+  // The safety columns go together: a rate means nothing without the function it threatens.
+  for (size_t c : {kFunction, kDangerous})
+    if (index[c] >= 0 && index[kRate] < 0)
+      throw common::InputError(fmt::format("{}:1:{}: the column '{}' needs a 'failure_rate' column (FIT) beside it", path,
+                                           cols[static_cast<size_t>(index[c])], header[static_cast<size_t>(index[c])]));
+  if (index[kRate] >= 0 && index[kFunction] < 0)
+    throw common::InputError(fmt::format("{}:1:{}: the column '{}' needs a 'safety_function' column beside it", path,
+                                         cols[static_cast<size_t>(index[kRate])], header[static_cast<size_t>(index[kRate])]));
+  out->has_rates = index[kRate] >= 0;
   std::set<std::string> ids;
   while (true) {
     ++line;
@@ -195,6 +247,8 @@ void parse_fmea(const std::string& path, Fmea* out) {
     if (r.alarm.empty()) throw common::InputError(at(11).str() + ": the alarm variable is empty");
     r.fault_model = get(12);
     r.fault_loc = at(12);
+    if (out->has_rates) read_safety_columns(r, get(kRate), at(kRate), get(kFunction), at(kFunction), get(kDangerous),
+                                            at(kDangerous), sep);
     out->rows.push_back(r);
   }
   if (out->rows.empty()) throw common::InputError(path + ":2:1: the FMEA has no rows");

@@ -16,6 +16,8 @@
 #include "campaign/explore.hpp"
 #include "campaign/generate.hpp"
 #include "campaign/parallel.hpp"
+#include "campaign/safety.hpp"
+#include "common/file.hpp"
 #include "commands.hpp"
 #include "options.hpp"
 #include "coverage_opts.hpp"
@@ -239,7 +241,7 @@ int cmd_generate(const std::vector<std::string>& args) {
 
 int cmd_campaign(const std::vector<std::string>& args) {
   const std::string usage =
-      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--explore] [--no-vcd] [--html DIR] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N]";
+      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--explore] [--no-vcd] [--html DIR] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N] [--baseline OLD_OUT [--fail-on-regression]]";
   po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
   desc.add_options()
       ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
@@ -259,6 +261,9 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with real time: pin the scan thread to this CPU")
       ("native", "run program, preconditions and monitors through the native tier")
       ("jobs", po::value<IntIn<1, 256>>(), "run the tests on N worker processes; the journal is the one --jobs 1 writes")
+      ("baseline", po::value<std::string>(), "an earlier run's output folder: report what changed in verdicts, DC and worst "
+                                             "reaction time (its safety.json; needs an FMEA with failure_rate)")
+      ("fail-on-regression", "with --baseline: exit 1 when something got worse (a PASS lost, a lower DC, a longer worst reaction, ...)")
       ("shard", po::value<std::string>(), "run share K of N (K = 0..N-1) into OUT/shard-K-of-N.jsonl; `plcfi merge` "
                                           "combines the N shard files into the campaign's journal");
   add_coverage_export_options(desc);
@@ -313,6 +318,30 @@ int cmd_campaign(const std::vector<std::string>& args) {
                                        (c.name + "-" + std::filesystem::path(c.programs.back()).stem().string()))
                                           .string();
   std::string err;
+  // The baseline is read before the campaign runs: a wrong folder is a usage error, not a
+  // surprise after an hour of testing.
+  std::optional<report::SafetyReport> baseline;
+  if (vm.count("fail-on-regression") && !vm.count("baseline")) {
+    std::cerr << "plcfi campaign: --fail-on-regression compares with an earlier run: add --baseline OLD_OUT\n";
+    return 2;
+  }
+  if (vm.count("baseline")) {
+    if (shard_n > 0) {
+      std::cerr << "plcfi campaign: --baseline compares a whole campaign; it does not go with --shard\n";
+      return 2;
+    }
+    if (!campaign::wants_safety_evidence(c)) {
+      std::cerr << "plcfi campaign: --baseline compares safety evidence, and " << c.fmea.path
+                << " has no failure_rate column (see README, \"Safety evidence\")\n";
+      return 2;
+    }
+    std::string path = (std::filesystem::path(vm["baseline"].as<std::string>()) / "safety.json").string(), text;
+    baseline.emplace();
+    if (!common::read_file(path, common::kMaxSpecBytes, &text, &err) || !report::parse_safety_json(text, path, &*baseline, &err)) {
+      std::cerr << "plcfi campaign: --baseline: " << err << "\n";
+      return 2;
+    }
+  }
   if (vm.count("html") && !html_dir_writable(vm["html"].as<std::string>(), &err)) {  // before a long campaign, not after it
     std::cerr << "plcfi campaign: " << err << "\n";
     return 2;
@@ -476,6 +505,34 @@ int cmd_campaign(const std::vector<std::string>& args) {
   }
   for (const auto& l : io_report) std::cout << "  " << l << "\n";
   if (cb.spec.explore.enabled && !print_suggestions(cb, res, out)) return 2;
+  // Safety evidence, only when the FMEA gives failure rates (else nothing changes).
+  std::optional<report::SafetyReport> safety;
+  if (campaign::wants_safety_evidence(c)) {
+    safety = campaign::safety_evidence(cb, res.executions, res.not_reached, res.pending, opt.vcd);
+    for (const auto& [name, text] : {std::pair{"safety.json", report::safety_json(*safety)},
+                                     {"traceability.csv", report::traceability_csv(*safety)}}) {
+      std::string path = (std::filesystem::path(out) / name).string();
+      std::ofstream f(path, std::ios::binary);
+      f << text;
+      if (!f) {
+        std::cerr << "plcfi campaign: " << path << ": cannot write\n";
+        return 2;
+      }
+    }
+    std::cout << report::safety_text(*safety, out);
+  }
+  size_t regressions = 0;
+  if (baseline) {
+    auto changes = report::compare_safety(*baseline, *safety);
+    for (const auto& ch : changes) regressions += ch.regression;
+    const std::string old = vm["baseline"].as<std::string>();
+    if (changes.empty()) {
+      std::cout << fmt::format("no change since {} (baseline)\n", old);
+    } else {
+      std::cout << fmt::format("{} change(s) since {} (baseline), {} regression(s)\n", changes.size(), old, regressions);
+      for (const auto& ch : changes) std::cout << fmt::format("  {} {}\n", ch.regression ? "REGRESSION" : "changed   ", ch.what);
+    }
+  }
 
   if (vm.count("junit")) {
     report::JunitSuite suite;
@@ -506,6 +563,8 @@ int cmd_campaign(const std::vector<std::string>& args) {
     suite.properties.emplace_back("plant", cb.spec.plant);
     for (size_t i = 0; i < io_report.size(); ++i) suite.properties.emplace_back(fmt::format("io_{}", i), io_report[i]);
     if (res.interrupted) suite.properties.emplace_back("incomplete", res.end_reason);
+    if (safety)
+      for (auto& prop : report::safety_junit_properties(*safety)) suite.properties.push_back(std::move(prop));
     for (size_t i : res.pending) {
       const auto& tc = cb.cases[i];
       report::JunitCase jc;
@@ -532,7 +591,9 @@ int cmd_campaign(const std::vector<std::string>& args) {
   }
   if (vm.count("html")) {
     std::string dir = vm["html"].as<std::string>();
-    if (!report::write_html_report(html_campaign_model(cb, res, out, opt.vcd), dir, &err)) {
+    auto model = html_campaign_model(cb, res, out, opt.vcd);
+    model.safety = safety;
+    if (!report::write_html_report(model, dir, &err)) {
       std::cerr << "plcfi campaign: " << err << "\n";
       return 2;
     }
@@ -543,6 +604,11 @@ int cmd_campaign(const std::vector<std::string>& args) {
     return 2;
   if (res.interrupted) {
     std::cout << "campaign incomplete (" << res.end_reason << "); finish it with --resume\n";
+    return 1;
+  }
+  if (regressions && vm.count("fail-on-regression")) {
+    std::cout << fmt::format("{} regression(s) since {}: failing (--fail-on-regression)\n", regressions,
+                             vm["baseline"].as<std::string>());
     return 1;
   }
   return fail || !res.not_reached.empty() ? 1 : 0;

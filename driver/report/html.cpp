@@ -647,6 +647,63 @@ void suggestions_section(const HtmlReport& r, std::string& o) {
   o += "</table></div>\n";
 }
 
+// Diagnostic coverage and reaction per safety function, the unassessed failures, then the
+// traceability matrix and the fingerprint that lets an assessor reproduce each line.
+void safety_section(const HtmlReport& r, std::string& o) {
+  if (!r.safety) return;
+  const SafetyReport& s = *r.safety;
+  o += "<h2 id=\"safety\">Safety evidence</h2>\n";
+  o += "<p class=\"small\">Rates in FIT (failures per 10<sup>9</sup> h). A row is detected when every execution of "
+       "every case and path PASSED; DC = &lambda;<sub>DD</sub> / &lambda;<sub>D</sub>, banded as IEC 61508-2 (none &lt; "
+       "60 %, low, medium from 90 %, high from 99 %). Reaction: from the injection of the fault to the scan in which the "
+       "class's reaction was complete; margin = safety time &minus; worst reaction.</p>\n";
+  o += "<div class=\"scroll\"><table class=\"safety\">\n<tr><th>safety function</th><th>rows</th><th>&lambda;<sub>D</sub></th>"
+       "<th>&lambda;<sub>DD</sub></th><th>DC</th><th>band</th><th>SFF</th><th>worst reaction</th><th>safety time</th>"
+       "<th>margin</th><th>undetected</th></tr>\n";
+  auto ms = [](int64_t ns) { return ns >= 0 ? ms_text(ns) + " ms" : std::string("-"); };
+  for (const auto& f : s.functions) {
+    std::string und;
+    for (const auto& [row, why] : f.undetected) und += fmt::format("<div><b>{}</b>: {}</div>", esc(row), esc(why));
+    bool bad = !f.undetected.empty() || (f.has_margin() && f.margin_ns() < 0);
+    o += fmt::format("<tr class=\"{}\" data-function=\"{}\"><td><b>{}</b></td><td>{}</td><td class=\"num\">{}</td>"
+                     "<td class=\"num\">{}</td><td class=\"num dc\">{}</td><td class=\"band\">{}</td><td class=\"num\">{}</td>"
+                     "<td class=\"num worst\">{}{}</td><td class=\"num\">{}</td><td class=\"num margin\">{}</td><td>{}</td></tr>\n",
+                     bad ? "fail" : "", esc(f.id), esc(f.id), esc(join(f.rows, " ")), fmt::format("{}", f.lambda_d),
+                     fmt::format("{}", f.lambda_dd), f.has_dc() ? fmt::format("{:.1f} %", f.dc() * 100) : "n/a", esc(f.band()),
+                     f.has_safe ? fmt::format("{:.1f} %", f.sff() * 100) : "-", ms(f.worst_reaction_ns),
+                     f.worst_execution.empty() ? "" : " <span class=\"small\">(" + esc(f.worst_execution) + ")</span>",
+                     ms(f.safety_time_ns), f.has_margin() ? ms(f.margin_ns()) : "-", und.empty() ? "none" : und);
+  }
+  o += "</table></div>\n";
+  if (!s.unassessed.empty()) {
+    o += "<h3>Unassessed failure modes (found by exploring, no FMEA row)</h3>\n<div class=\"scroll\"><table class=\"unassessed\">\n"
+         "<tr><th>case</th><th>path</th><th>verdict</th><th>transition</th><th>fault</th><th>reason</th></tr>\n";
+    for (const auto& u : s.unassessed)
+      o += fmt::format("<tr class=\"fail\"><td>{}</td><td class=\"num\">{}</td><td>{}</td><td><code>{}</code></td><td>{}</td>"
+                       "<td class=\"reason\">{}</td></tr>\n",
+                       esc(u.case_id), u.path, esc(u.verdict), esc(u.transition), esc(u.fault), esc(u.reason));
+    o += "</table></div>\n";
+  }
+  o += "<h3 id=\"traceability\">Traceability: FMEA row, case, path, verdict, evidence</h3>\n"
+       "<div class=\"scroll\"><table class=\"trace\">\n<tr><th>FMEA</th><th>function</th><th>FIT</th><th>dangerous</th>"
+       "<th>case</th><th>path</th><th>verdict</th><th>reaction</th><th>latency</th><th>safety time</th><th>journal line</th>"
+       "<th>VCD</th><th>diagrams</th></tr>\n";
+  for (const auto& t : s.trace) {
+    const char* cls = t.verdict == "PASS" ? "" : t.verdict == "FAIL" ? "fail" : "nr";
+    o += fmt::format("<tr class=\"{}\"><td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td>"
+                     "<td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
+                     "<td><code>{}</code></td><td><code>{}</code> <code>{}</code></td></tr>\n",
+                     cls, t.fmea.empty() ? "-" : esc(t.fmea), esc(t.safety_function),
+                     t.failure_rate >= 0 ? fmt::format("{}", t.failure_rate) : "", esc(t.dangerous), esc(t.case_id),
+                     t.path ? std::to_string(t.path) : "-", esc(t.verdict), ms(t.reaction_ns), ms(t.latency_ns),
+                     ms(t.safety_time_ns), t.journal_line ? std::to_string(t.journal_line) : "-", esc(t.vcd),
+                     esc(t.sequence_diagram), esc(t.timing_diagram));
+  }
+  o += "</table></div>\n<h3>Fingerprint</h3>\n<dl class=\"facts fingerprint\">\n";
+  for (const auto& [k, v] : s.fingerprint) o += fmt::format("<dt>{}</dt><dd><code>{}</code></dd>\n", esc(k), esc(v));
+  o += "</dl>\n";
+}
+
 void mutants_section(const HtmlReport& r, std::string& o) {
   if (r.mutants.empty()) return;
   size_t killed = 0, survived = 0, equivalent = 0;
@@ -680,6 +737,7 @@ std::string html_report(const HtmlReport& r) {
   o += "<style>" + std::string(kCss) + "</style>\n</head>\n<body>\n<main>\n";
   header_section(r, o);
   if (!r.rows.empty() || r.mutants.empty()) table_section(r, o);  // a mutation page has no verdict rows
+  safety_section(r, o);
   suggestions_section(r, o);
   mutants_section(r, o);
   executions_section(r, o);

@@ -1,14 +1,17 @@
 // A self-contained HTML report of a fault-injection campaign: one index.html with inline
 // CSS and inline SVG (verdict table, the waveform of each test window read from its VCD,
-// the timing sequence diagrams, FMEA suggestions, mutants). The model below is plain
+// the timing sequence diagrams, FMEA suggestions, mutants, safety evidence). The model below is plain
 // data so that any producer (the campaign, exploration, mutation analysis) can fill it;
 // the report layer knows nothing of driver/campaign.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "report/safety.hpp"
 
 namespace plcfi::report {
 
@@ -117,6 +120,9 @@ struct HtmlReport {
   std::vector<HtmlScenario> scenarios;
   std::vector<FmeaSuggestion> suggestions;
   std::vector<MutantRow> mutants;
+  // The safety evidence (an FMEA with failure rates): per safety function, the
+  // traceability matrix and the fingerprint; none: no section.
+  std::optional<SafetyReport> safety;
 };
 
 // The page as text. Every string of the model is HTML-escaped; traces that cannot be read

@@ -207,6 +207,41 @@ TEST(CampaignSpec, FmeaQuotedFieldsAndSemicolons) {
   fs::remove(p);
 }
 
+// The safety columns: a decimal comma under ';', dangerous no, a row outside every safety
+// function, and an FMEA without the columns (has_rates false, the rows' defaults).
+TEST(CampaignSpec, FmeaSafetyColumns) {
+  fs::path p = fs::temp_directory_path() / ("plcfi_fmea_safety_" + std::to_string(::getpid()) + ".csv");
+  write(p,
+        "id;tsd_transition;S;O;D;RPN;fault_class;alarm;failure_rate;safety_function;dangerous\n"
+        "A;a.b.c;2;3;4;24;1;gA;12,5;SF_a;no\n"
+        "B;a.b.c;2;3;4;24;1;gA;7;SF_a;\n"
+        "C;a.b.c;2;3;4;24;1;gA;;;\n");
+  Fmea f;
+  std::string err;
+  ASSERT_TRUE(load_fmea(p.string(), &f, &err)) << err;
+  EXPECT_TRUE(f.has_rates);
+  ASSERT_EQ(f.rows.size(), 3u);
+  EXPECT_DOUBLE_EQ(f.rows[0].failure_rate, 12.5);
+  EXPECT_EQ(f.rows[0].safety_function, "SF_a");
+  EXPECT_FALSE(f.rows[0].dangerous);
+  EXPECT_DOUBLE_EQ(f.rows[1].failure_rate, 7);
+  EXPECT_TRUE(f.rows[1].dangerous);
+  EXPECT_EQ(f.rows[2].safety_function, "");
+  EXPECT_LT(f.rows[2].failure_rate, 0);
+  fs::remove(p);
+
+  Fmea plain;
+  ASSERT_TRUE(load_fmea((kSpecDir / "fmea.csv").string(), &plain, &err)) << err;
+  EXPECT_FALSE(plain.has_rates);
+  for (const auto& r : plain.rows) EXPECT_LT(r.failure_rate, 0);
+
+  FaultClasses fc;
+  ASSERT_TRUE(load_fault_classes((kSpecDir / "fault_classes_safety.yaml").string(), &fc, &err)) << err;
+  ASSERT_NE(fc.find("1"), nullptr);
+  EXPECT_EQ(fc.find("1")->safety_time_ns, 2'000'000'000);
+  EXPECT_EQ(fc.find("2")->safety_time_ns, 15'000'000'000);
+}
+
 // ------------------------------------------------------------------ generation
 
 TEST(CampaignGenerate, OneCasePerFmeaRowInRpnOrder) {
