@@ -51,8 +51,9 @@ std::unique_ptr<Application> compile(const SourceManager& sm, const std::vector<
 bool link_units(Application& app, const SourceManager& sm, const std::vector<const CompilationUnit*>& units,
                 DiagEngine& diags, const CompileOptions& options);
 
-// The standard library's ST source (standard FBs), compiled with every application.
-const char* stdlib_source();
+// The standard library's ST source (standard FBs) for a dialect, compiled with every
+// application.
+const char* stdlib_source(Dialect d);
 // The TcUnit framework's ST source (FB_TestSuite, RUN), compiled with an application whose
 // sources use it (stdlib/tcunit.cpp).
 const char* tcunit_source();

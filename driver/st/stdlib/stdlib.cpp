@@ -68,7 +68,29 @@ END_FUNCTION_BLOCK
   return text;
 }
 
-std::string build_stdlib() {
+// F_TRIG as the dialect defines it. IEC 61131-3 (2nd edition on, and MATIEC): M holds NOT
+// CLK, so a first call with CLK FALSE is a falling edge. CODESYS's and TwinCAT's standard
+// libraries keep the 1st edition's: M holds CLK, and a first call gives no edge.
+const char* f_trig(Dialect d) {
+  return d == Dialect::Iec ? R"ST(FUNCTION_BLOCK F_TRIG
+VAR_INPUT CLK : BOOL; END_VAR
+VAR_OUTPUT Q : BOOL; END_VAR
+VAR M : BOOL; END_VAR
+Q := NOT CLK AND NOT M;
+M := NOT CLK;
+END_FUNCTION_BLOCK
+)ST"
+                           : R"ST(FUNCTION_BLOCK F_TRIG
+VAR_INPUT CLK : BOOL; END_VAR
+VAR_OUTPUT Q : BOOL; END_VAR
+VAR M : BOOL; END_VAR
+Q := NOT CLK AND M;
+M := CLK;
+END_FUNCTION_BLOCK
+)ST";
+}
+
+std::string build_stdlib(Dialect d) {
   std::string text = R"ST(
 (* The state of a textual SFC (syntax/sfc_lower.hpp): a step (X active, T time active), an
    action control (Q its output, A active including the final scan) and the chart's clock. *)
@@ -164,13 +186,7 @@ Q := CLK AND NOT M;
 M := CLK;
 END_FUNCTION_BLOCK
 
-FUNCTION_BLOCK F_TRIG
-VAR_INPUT CLK : BOOL; END_VAR
-VAR_OUTPUT Q : BOOL; END_VAR
-VAR M : BOOL; END_VAR
-Q := NOT CLK AND M;
-M := CLK;
-END_FUNCTION_BLOCK
+@F_TRIG
 
 (* SR: set dominant. RS: reset dominant. *)
 FUNCTION_BLOCK SR
@@ -190,13 +206,15 @@ END_FUNCTION_BLOCK
   text += counters("_LINT", "LINT", "-9223372036854775807", "9223372036854775807");
   text += counters("_UDINT", "UDINT", "0", "4294967295");
   text += counters("_ULINT", "ULINT", "0", "18446744073709551615");
+  text.replace(text.find("@F_TRIG"), 7, f_trig(d));
   return text;
 }
 }  // namespace
 
-const char* stdlib_source() {
-  static const std::string text = build_stdlib();
-  return text.c_str();
+const char* stdlib_source(Dialect d) {
+  static const std::string iec = build_stdlib(Dialect::Iec);
+  static const std::string codesys = build_stdlib(Dialect::Codesys);
+  return d == Dialect::Iec ? iec.c_str() : codesys.c_str();
 }
 
 }  // namespace plcfi::st
