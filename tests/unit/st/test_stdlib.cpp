@@ -283,8 +283,10 @@ TEST_F(Stdlib, RTrigIsTrueForOneCallOnARisingEdge) {
 }
 
 TEST_F(Stdlib, FTrigIsTrueForOneCallOnAFallingEdge) {
+  // IEC 61131-3 (2nd edition): a first call with CLK FALSE is a falling edge (M starts
+  // FALSE and holds NOT CLK).
   const bool clk[] = {false, true, true, false, false, true, false};
-  const bool want[] = {false, false, false, true, false, false, true};
+  const bool want[] = {true, false, false, true, false, false, true};
   for (int i = 0; i < 7; ++i) {
     set("ft", "CLK", clk[i]);
     call("ft", i);
