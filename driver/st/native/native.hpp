@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "native_abi.hpp"
@@ -26,6 +27,16 @@ struct NativeOptions {
 // tests and observers. `entries` receives the entries translated, `skipped` those left
 // to the interpreter (an instruction the translator does not handle).
 std::string native_source(const Application& app, std::vector<uint32_t>* entries, std::vector<uint32_t>* skipped);
+
+// The memory the native tier does not keep exact: the compiler temporaries of every POU
+// instance and frame (each frame's last part; a FUNCTION's frame lies in its caller's
+// temporaries) and the method stack. A temporary is scratch within one statement: no
+// variable, probe, report or later scan reads what a finished one left there, and the
+// native tier leaves out the stores nobody reads back. Everything else in memory is the
+// same in both tiers after every call. Absolute (start, end) pairs, sorted.
+std::vector<std::pair<uint64_t, uint64_t>> scratch_ranges(const Application& app);
+// The first address below n where a and b differ outside scratch (n: none).
+uint64_t first_difference(const std::vector<std::pair<uint64_t, uint64_t>>& scratch, const uint8_t* a, const uint8_t* b, uint64_t n);
 
 class NativeCode {
  public:

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "memory.hpp"
+#include "ops.hpp"
 #include "vm.hpp"
 #include "wide.hpp"
 
@@ -141,13 +142,23 @@ void s_find(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) {
   auto pos = t.empty() ? Text<Ch>::npos : s.find(t);
   store_as<int16_t>(a, pos == Text<Ch>::npos ? int16_t(0) : static_cast<int16_t>(pos + 1));
 }
+// On STRING the in-place versions of ops.hpp, which the native tier calls too.
+void s_len_b(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { ops::str_len(a, b); }
+void s_left_b(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) { ops::str_left(a, cap, b, load_as<int64_t>(c)); }
+void s_right_b(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) { ops::str_right(a, cap, b, load_as<int64_t>(c)); }
+void s_mid_b(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t* d) {
+  ops::str_mid(a, cap, b, load_as<int64_t>(c), load_as<int64_t>(d));
+}
+void s_concat_b(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) { ops::str_concat(a, cap, b, c); }
+void s_find_b(Machine&, uint32_t, uint8_t* a, uint8_t* b, uint8_t* c, uint8_t*) { ops::str_find(a, b, c); }
+
 // STRING_TO_WSTRING and back: a (capacity cap) := b, between UTF-8 and UTF-16.
 void s_to_w(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { store_wstring(a, cap, utf8_to_utf16(cs(b))); }
 void w_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) {
   put(a, cap, utf16_to_utf8(load_wstring(b, SIZE_MAX)));
 }
 
-void i64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(load_as<int64_t>(b))); }
+void i64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { ops::str_of_i64(a, cap, load_as<int64_t>(b)); }
 void u64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, std::to_string(load_as<uint64_t>(b))); }
 void f32_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", load_as<float>(b))); }
 void f64_to_s(Machine&, uint32_t cap, uint8_t* a, uint8_t* b, uint8_t*, uint8_t*) { put(a, cap, fmt::format("{}", load_as<double>(b))); }
@@ -366,9 +377,9 @@ constexpr Entry kNatives[] = {
 #define X(n) {n##_F32, #n "_F32"}, {n##_F64, #n "_F64"},
     PLCFI_NATIVE_MATH(X)
 #undef X
-    {s_len<char>, "LEN"}, {s_left<char>, "LEFT"}, {s_right<char>, "RIGHT"}, {s_mid<char>, "MID"},
-    {s_concat<char>, "CONCAT"}, {s_insert<char>, "INSERT"}, {s_delete<char>, "DELETE"},
-    {s_replace<char>, "REPLACE"}, {s_find<char>, "FIND"},
+    {s_len_b, "LEN"}, {s_left_b, "LEFT"}, {s_right_b, "RIGHT"}, {s_mid_b, "MID"},
+    {s_concat_b, "CONCAT"}, {s_insert<char>, "INSERT"}, {s_delete<char>, "DELETE"},
+    {s_replace<char>, "REPLACE"}, {s_find_b, "FIND"},
     {s_len<char16_t>, "WLEN"}, {s_left<char16_t>, "WLEFT"}, {s_right<char16_t>, "WRIGHT"}, {s_mid<char16_t>, "WMID"},
     {s_concat<char16_t>, "WCONCAT"}, {s_insert<char16_t>, "WINSERT"}, {s_delete<char16_t>, "WDELETE"},
     {s_replace<char16_t>, "WREPLACE"}, {s_find<char16_t>, "WFIND"},

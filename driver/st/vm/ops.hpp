@@ -164,4 +164,61 @@ inline int wscmp(const uint8_t* a, const uint8_t* b) {
   }
 }
 
+// STRING: bytes ended by a 0 byte, in a variable of capacity cap (cap + 1 bytes). The
+// standard functions work on the variables in place, with no heap: the interpreter's
+// natives (natives.cpp) and the native tier's generated code call these. A result may
+// be written over an argument (s := LEFT(s, 2), s := CONCAT(s, t), s := CONCAT(t, s)):
+// every copy is a memmove, made in the order that reads each source before it is
+// overwritten. Lengths and positions are clamped as natives.cpp documents.
+inline size_t slen(const uint8_t* p) { return std::strlen(reinterpret_cast<const char*>(p)); }
+inline void sput(uint8_t* dst, uint32_t cap, const uint8_t* src, size_t n) {
+  if (n > cap) n = cap;
+  std::memmove(dst, src, n);
+  dst[n] = 0;
+}
+inline size_t sclamp(int64_t v, size_t max) { return v < 0 ? 0 : static_cast<uint64_t>(v) < max ? static_cast<size_t>(v) : max; }
+inline void str_len(uint8_t* a, const uint8_t* b) { st<int16_t>(a, static_cast<int16_t>(slen(b))); }
+inline void str_left(uint8_t* a, uint32_t cap, const uint8_t* b, int64_t l) { sput(a, cap, b, sclamp(l, slen(b))); }
+inline void str_right(uint8_t* a, uint32_t cap, const uint8_t* b, int64_t l) {
+  size_t n = slen(b), k = sclamp(l, n);
+  sput(a, cap, b + (n - k), k);
+}
+inline void str_mid(uint8_t* a, uint32_t cap, const uint8_t* b, int64_t l, int64_t p) {
+  size_t n = slen(b);
+  if (p < 1 || static_cast<uint64_t>(p) > n) {
+    a[0] = 0;
+    return;
+  }
+  size_t from = static_cast<size_t>(p - 1), k = sclamp(l, n);
+  sput(a, cap, b + from, k < n - from ? k : n - from);
+}
+inline void str_concat(uint8_t* a, uint32_t cap, const uint8_t* b, const uint8_t* c) {
+  size_t nb = slen(b), nc = slen(c);
+  if (nb > cap) nb = cap;
+  if (nc > cap - nb) nc = cap - nb;
+  std::memmove(a + nb, c, nc);  // first: the result may be written over c
+  if (a != b) std::memmove(a, b, nb);
+  a[nb + nc] = 0;
+}
+// FIND: the 1-based position of c's first occurrence in b, 0 when absent or c is empty.
+inline void str_find(uint8_t* a, const uint8_t* b, const uint8_t* c) {
+  const char* s = reinterpret_cast<const char*>(b);
+  const char* t = reinterpret_cast<const char*>(c);
+  const char* at = *t ? std::strstr(s, t) : nullptr;
+  st<int16_t>(a, at ? static_cast<int16_t>(at - s + 1) : int16_t(0));
+}
+// A signed integer's decimal text (INT_TO_STRING and the other signed conversions).
+inline void str_of_i64(uint8_t* a, uint32_t cap, int64_t v) {
+  char buf[24];
+  char* end = buf + sizeof buf;
+  char* p = end;
+  uint64_t u = v < 0 ? uint64_t{0} - static_cast<uint64_t>(v) : static_cast<uint64_t>(v);
+  do {
+    *--p = static_cast<char>('0' + u % 10);
+    u /= 10;
+  } while (u);
+  if (v < 0) *--p = '-';
+  sput(a, cap, reinterpret_cast<const uint8_t*>(p), static_cast<size_t>(end - p));
+}
+
 }  // namespace plcfi::st::ops

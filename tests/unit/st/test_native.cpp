@@ -6,12 +6,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <regex>
 #include <sstream>
 
 #include "engine.hpp"
 #include "native/native.hpp"
+#include "same_memory.hpp"
 #include "testing/test_files.hpp"
 
 namespace plcfi::st {
@@ -62,7 +64,7 @@ int compare_runs(const Pair& p, int scans, uint64_t budget = 100'000) {
       EXPECT_EQ(a.trap().pc, n.trap().pc);
       EXPECT_EQ(a.trap().message, n.trap().message);
       EXPECT_EQ(describe_trap(app, a.trap()), describe_trap(app, n.trap()));
-      EXPECT_EQ(0, std::memcmp(a.mem(), n.mem(), a.mem_size())) << "memory differs after scan " << s;
+      EXPECT_TRUE(same_memory(app, a, n)) << "memory differs after scan " << s;
       EXPECT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
       EXPECT_EQ(a.now(), n.now());
       if (!ra) return s;
@@ -85,6 +87,99 @@ TEST(NativeTier, BenchKernelsScanLikeTheInterpreter) {
     ASSERT_TRUE(p.native);
     EXPECT_EQ(compare_runs(p, 50, 10'000'000), -1);
   }
+}
+
+// Issue 31's kernels (both halves): bits, strings, REAL FBs, enum CASE, loops, arrays of
+// structs, timers and edges. The same memory outside compiler temporaries after every scan.
+TEST(NativeTier, Matiec31KernelsScanLikeTheInterpreter) {
+  for (const char* k : {"crc16_parity", "bitpack", "str_build", "real_ctrl", "enum_fsm", "int_nested", "struct_sort", "crc32",
+                        "str_parse", "ring_filter", "fb_timers", "int_while", "struct_search"}) {
+    SCOPED_TRACE(k);
+    std::string file = std::string(k) + ".st";
+    Pair p = build_both({{file, read_file(std::string(PLCFI_SOURCE_DIR) + "/tests/bench/matiec31/" + file)}});
+    ASSERT_TRUE(p.native);
+    EXPECT_EQ(compare_runs(p, 20, 10'000'000), -1);
+  }
+}
+
+// Scratch is only ever a frame's temporaries: no variable of a program, of an FB
+// instance inside it (arrays of instances included) or of a global instance lies in it.
+TEST(NativeTier, ScratchRangesHoldNoVariable) {
+  const char* src = R"(FUNCTION_BLOCK Cell
+VAR_INPUT x : DINT; END_VAR
+VAR_OUTPUT y : DINT; END_VAR
+VAR acc : ARRAY [0..3] OF DINT; END_VAR
+acc[x MOD 4] := acc[x MOD 4] + x * 2 + 1;
+y := acc[0] + acc[1] * 3;
+END_FUNCTION_BLOCK
+VAR_GLOBAL g : Cell; END_VAR
+PROGRAM Main
+VAR cells : ARRAY [1..3] OF Cell; one : Cell; n : DINT; total : DINT; END_VAR
+n := n + 1;
+cells[n MOD 3 + 1](x := n * 5);
+one(x := n);
+g(x := n + 2);
+total := cells[1].y + cells[2].y + cells[3].y + one.y + g.y;
+END_PROGRAM
+)";
+  Pair p = build_both({{"scratch.st", src}});
+  ASSERT_TRUE(p.native);
+  const Application& app = *p.b->app;
+  auto scratch = scratch_ranges(app);
+  ASSERT_FALSE(scratch.empty());
+  auto clear_of = [&](uint64_t from, uint64_t to, const std::string& what) {
+    for (auto [a, e] : scratch) EXPECT_TRUE(e <= from || to <= a) << what << " [" << from << ", " << to << ") in scratch [" << a << ", " << e << ")";
+  };
+  std::function<void(const PouInfo*, uint64_t, const std::string&)> vars = [&](const PouInfo* pou, uint64_t at, const std::string& path) {
+    for (const auto& v : pou->vars) {
+      if (v->where != Where::Frame) continue;
+      bool instances = v->type->kind == TypeKind::Pou || (v->type->kind == TypeKind::Array && v->type->elem->kind == TypeKind::Pou);
+      if (!instances) clear_of(at + v->offset, at + v->offset + v->type->size, path + "." + v->name);  // an instance holds its temporaries
+      if (v->type->kind == TypeKind::Pou) vars(v->type->pou, at + v->offset, path + "." + v->name);
+      if (v->type->kind == TypeKind::Array && v->type->elem->kind == TypeKind::Pou)
+        for (uint32_t k = 0; k < 3; ++k) vars(v->type->elem->pou, at + v->offset + k * v->type->elem->size, path + "." + v->name + "[]");
+    }
+  };
+  for (const auto& inst : app.programs) vars(inst.pou, inst.addr, inst.name);
+  for (const auto& g : app.globals)
+    if (g.sym->where == Where::Abs) {
+      vars(g.sym->type->pou, g.sym->offset, g.sym->name);
+    }
+  EXPECT_EQ(compare_runs(p, 30), -1);
+}
+
+// A loop over a two-dimensional array keeps its temporaries in registers: no store of a
+// temporary, and no null or memory-bounds check on an element proven inside its array
+// (the index checks stay).
+TEST(NativeTier, ArrayLoopTemporariesStayInRegisters) {
+  const char* src = R"(PROGRAM Main
+VAR m : ARRAY [0..7, 0..7] OF DINT; i : DINT; j : DINT; s : DINT; END_VAR
+FOR i := 0 TO 7 DO
+  FOR j := 0 TO 7 DO
+    m[i, j] := m[j, i] + i * 8 + j;
+    s := s + m[i, j] MOD 7;
+  END_FOR;
+END_FOR;
+END_PROGRAM
+)";
+  Pair p = build_both({{"loop.st", src}});
+  ASSERT_TRUE(p.native);
+  const Application& app = *p.b->app;
+  std::vector<uint32_t> entries, skipped;
+  std::string code = native_source(app, &entries, &skipped);
+  const PouInfo* main = app.programs.at(0).pou;
+  const uint64_t temps = (uint64_t{main->const_from} + main->consts.size() + 7) & ~uint64_t{7};
+  std::regex store(R"(st<\w+>\(base \+ (\d+)u)");
+  int stores = 0;
+  for (auto it = std::sregex_iterator(code.begin(), code.end(), store); it != std::sregex_iterator(); ++it) {
+    ++stores;
+    EXPECT_LT(std::stoull((*it)[1]), temps) << "a store of a temporary: " << it->str();
+  }
+  EXPECT_GT(stores, 0);  // the variables are still stored
+  EXPECT_EQ(code.find("TRAP(4,"), std::string::npos) << "a null check";
+  EXPECT_EQ(code.find("TRAP(9,"), std::string::npos) << "a memory-bounds check";
+  EXPECT_NE(code.find("TRAP(2,"), std::string::npos) << "the index checks are kept";
+  EXPECT_EQ(compare_runs(p, 5), -1);
 }
 
 // Direct calls into functions that cannot recurse skip the general call's bookkeeping
@@ -158,7 +253,7 @@ TEST(NativeTier, DirectCallsKeepDepthTrapsAndTheWatchdogExact) {
     bool rn = n.call(inst.pou->entry, inst.addr);
     ASSERT_EQ(ra, rn) << "scan " << s;
     EXPECT_EQ(describe_trap(app, a.trap()), describe_trap(app, n.trap())) << "scan " << s;
-    EXPECT_EQ(0, std::memcmp(a.mem(), n.mem(), a.mem_size())) << "memory differs after scan " << s;
+    EXPECT_TRUE(same_memory(app, a, n)) << "memory differs after scan " << s;
     EXPECT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
     if (!ra) seen.push_back(a.trap().kind);
   }

@@ -12,6 +12,7 @@
 
 #include "engine.hpp"
 #include "native/native.hpp"
+#include "same_memory.hpp"
 #include "vm_run.hpp"
 
 namespace plcfi::st {
@@ -40,7 +41,7 @@ void same_in_both_tiers(const std::string& src, int scans) {
     bool rn = n.call(inst.pou->entry, inst.addr);
     ASSERT_EQ(ra, rn) << "scan " << s;
     EXPECT_EQ(describe_trap(*b->app, a.trap()), describe_trap(*b->app, n.trap())) << "scan " << s;
-    ASSERT_EQ(0, std::memcmp(a.mem(), n.mem(), a.mem_size())) << "memory differs after scan " << s;
+    ASSERT_TRUE(same_memory(*b->app, a, n)) << "memory differs after scan " << s;
     ASSERT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
   }
 }
