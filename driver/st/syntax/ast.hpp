@@ -21,6 +21,49 @@ struct Ident {
   SourceLoc loc;
 };
 
+// std::optional's interface for a field that is nearly always empty, one pointer wide: the
+// value, when there is one, lives on the heap. A program of 2,000 FBs has some 30,000
+// declarations; an inline optional<DirectAddrExpr> would make each 88 bytes bigger.
+template <class T>
+class OptionalBox {
+ public:
+  OptionalBox() = default;
+  OptionalBox(std::nullopt_t) {}
+  OptionalBox(T v) : p_(std::make_unique<T>(std::move(v))) {}
+  OptionalBox(const OptionalBox& o) : p_(o.p_ ? std::make_unique<T>(*o.p_) : nullptr) {}
+  OptionalBox(OptionalBox&&) noexcept = default;
+  OptionalBox& operator=(const OptionalBox& o) {
+    if (this != &o) p_ = o.p_ ? std::make_unique<T>(*o.p_) : nullptr;
+    return *this;
+  }
+  OptionalBox& operator=(OptionalBox&&) noexcept = default;
+  OptionalBox& operator=(std::nullopt_t) {
+    p_.reset();
+    return *this;
+  }
+  OptionalBox& operator=(T v) {
+    p_ = std::make_unique<T>(std::move(v));
+    return *this;
+  }
+  template <class... A>
+  T& emplace(A&&... a) {
+    p_ = std::make_unique<T>(std::forward<A>(a)...);
+    return *p_;
+  }
+  void reset() { p_.reset(); }
+  bool has_value() const { return p_ != nullptr; }
+  explicit operator bool() const { return p_ != nullptr; }
+  T& operator*() { return *p_; }
+  const T& operator*() const { return *p_; }
+  T* operator->() { return p_.get(); }
+  const T* operator->() const { return p_.get(); }
+  T& value() { return *p_; }
+  const T& value() const { return *p_; }
+
+ private:
+  std::unique_ptr<T> p_;
+};
+
 // ---------------------------------------------------------------- expressions
 
 enum class ExprKind {
@@ -230,7 +273,7 @@ struct TypeSpec {
   ExprPtr sub_lo, sub_hi;
   bool is_pointer = false;  // Ref spelt POINTER TO
   bool is_union = false;      // Struct spelt UNION ... END_UNION (CODESYS): every member at offset 0
-  std::optional<Ident> struct_base;  // TYPE T EXTENDS B : STRUCT (CODESYS): B's members first
+  OptionalBox<Ident> struct_base;  // TYPE T EXTENDS B : STRUCT (CODESYS): B's members first
   bool is_reference = false;  // Ref spelt REFERENCE TO (CODESYS): dereferenced implicitly on every use
   // Named: `fb : FB_X(a := 1)` in a VAR block (CODESYS): the arguments of the instance's
   // FB_init, called at every restart.
@@ -245,7 +288,7 @@ using TypeSpecPtr = std::unique_ptr<TypeSpec>;
 // One declaration line: `a, b AT %IX0.0 : INT := 5;` (AT only with a single name).
 struct VarDecl {
   std::vector<Ident> names;
-  std::optional<DirectAddrExpr> location;  // AT %IX0.0 (may be partly specified: %I*)
+  OptionalBox<DirectAddrExpr> location;  // AT %IX0.0 (may be partly specified: %I*)
   TypeSpecPtr type;
   ExprPtr init;             // may be null
   VarSection section = VarSection::Var;

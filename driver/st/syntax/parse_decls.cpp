@@ -76,6 +76,7 @@ VarBlock Parser::parse_var_block() {
     d.constant = block.constant;
     d.retain = block.retain;
   }
+  block.decls.shrink_to_fit();  // the tree lives through compilation: no growth slack
   return block;
 }
 
@@ -106,7 +107,7 @@ bool Parser::parse_var_decl(std::vector<VarDecl>& out, VarSection section, bool 
       addr.area = t.area;
       addr.size = t.size;
       addr.parts = t.parts;
-      decl.location = addr;
+      decl.location = std::move(addr);
     } else {
       error("ST123", missing_loc(), "expected a direct address such as %IX0.0 after AT, found " + describe(cur()));
     }
@@ -350,7 +351,7 @@ void Parser::parse_type_block(std::vector<TypeDecl>& out) {
       td.spec = parse_type_spec();
       if (base) {
         if (td.spec->kind == TypeSpecKind::Struct && !td.spec->is_union)
-          td.spec->struct_base = base;
+          td.spec->struct_base = *base;
         else
           error("ST119", base->loc, "only a STRUCT can EXTEND another ('" + td.name.text + "' is not a STRUCT)");
       }

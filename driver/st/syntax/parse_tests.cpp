@@ -61,6 +61,7 @@ std::unique_ptr<TestFile> Parser::parse_test_file() {
   tf->file = file_;
   tf->decls.file = file_;
   while (!at(Tok::Eof)) {
+    release_tokens();
     const size_t before = pos_;
     if (at_test_block_start()) {
       const Token& kw = advance();

@@ -96,6 +96,7 @@ std::unique_ptr<CompilationUnit> Parser::parse_unit() {
   auto unit = std::make_unique<CompilationUnit>();
   unit->file = file_;
   while (!at(Tok::Eof)) {
+    release_tokens();
     const size_t before = pos_;
     parse_top_level(*unit);
     if (pos_ == before) advance();

@@ -124,10 +124,21 @@ class Parser {
 
   // ------------------------------------------------------------ token access
   // Tokens are lexed on demand so lexical and syntax errors come out in source order; a
-  // deque keeps references to earlier tokens valid while it grows.
+  // deque keeps references to earlier tokens valid while it grows. Indexes are absolute:
+  // toks_[0] is token number base_; tokens of finished top-level declarations are released
+  // (release_tokens), so a large file never holds all its tokens at once.
   const Token& tok(size_t i) const {
-    while (toks_.size() <= i && (toks_.empty() || toks_.back().kind != Tok::Eof)) toks_.push_back(lexer_.next());
-    return toks_[std::min(i, toks_.size() - 1)];
+    while (base_ + toks_.size() <= i && (toks_.empty() || toks_.back().kind != Tok::Eof))
+      toks_.push_back(lexer_.next());
+    return toks_[std::min(std::max(i, base_), base_ + toks_.size() - 1) - base_];
+  }
+  // Between top-level declarations nothing looks further back than the previous token
+  // (prev(), first_on_line()): drop the ones before it.
+  void release_tokens() {
+    while (base_ + 1 < pos_ && !toks_.empty()) {
+      toks_.pop_front();
+      ++base_;
+    }
   }
   const Token& cur() const { return tok(pos_); }
   const Token& la(size_t n) const { return tok(pos_ + n); }
@@ -191,10 +202,10 @@ class Parser {
     advance();
   }
   std::string source_text(size_t from_tok, size_t to_tok) const {
-    if (from_tok >= to_tok || to_tok > toks_.size()) return "";
+    if (from_tok >= to_tok || from_tok < base_ || to_tok > base_ + toks_.size()) return "";
     const auto& text = sm_.file(file_).text;
-    const size_t begin = toks_[from_tok].offset;
-    const size_t end = toks_[to_tok - 1].offset + toks_[to_tok - 1].text.size();
+    const size_t begin = toks_[from_tok - base_].offset;
+    const size_t end = toks_[to_tok - 1 - base_].offset + toks_[to_tok - 1 - base_].text.size();
     std::string s = text.substr(begin, end - begin);
     for (char& c : s)
       if (c == '\n' || c == '\r' || c == '\t') c = ' ';
@@ -353,6 +364,7 @@ class Parser {
   bool test_mode_;
   mutable Lexer lexer_;
   mutable std::deque<Token> toks_;
+  size_t base_ = 0;  // the absolute index of toks_.front()
   size_t pos_ = 0;
   size_t last_error_pos_ = SIZE_MAX;
   int depth_ = 0;
