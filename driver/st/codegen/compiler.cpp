@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <type_traits>
 
 #include "compiler_impl.hpp"
 #include "vm/memory.hpp"
@@ -124,6 +125,28 @@ Compiler::Compiler(const SourceManager& sm, DiagEngine& diags, const CompileOpti
     : sm_(sm), diags_(diags), opt_(opt) {}
 
 // ------------------------------------------------------------------ emission
+
+// A finished body's code, lines and layout tables were copied into the application by
+// finish_body, and its lookup tables only serve the compilation of its own statements:
+// all of it is freed, so a large application never holds every POU's tables at once.
+// The symbols it made (methods' This-symbols) live on, because PouInfo and the
+// diagnostics point to them.
+static void drop_finished_tables(Body& b) {
+  auto drop = [](auto& v) { std::remove_reference_t<decltype(v)>().swap(v); };
+  drop(b.code);
+  drop(b.lines);
+  drop(b.label_pos);
+  drop(b.target_fix);
+  drop(b.slot_fix);
+  drop(b.entry_fix);
+  drop(b.template_fix);
+  drop(b.consts);
+  drop(b.const_index);
+  drop(b.cvt_cache);
+  drop(b.locals);
+  drop(b.goto_labels);
+  drop(b.loops);
+}
 
 void Compiler::emit(Op op, std::initializer_list<Arg> args) { emit_list(op, std::vector<Arg>(args)); }
 
@@ -358,6 +381,7 @@ void Compiler::compile_pou(PouInfo* p) {
       diags_.warning("ST400", v->loc, "variable '" + v->name + "' is declared but never used");
     }
   }
+  drop_finished_tables(*body);
   bodies_.push_back(std::move(body));
   b_ = saved_b;
   file_ = saved_file;
@@ -490,6 +514,7 @@ void Compiler::compile_test(const TestFile& tf, const TestCase& tc) {
   p->has_init = init_at != 0;
   p->has_exit = exit_at != 0;
   p->compiled = true;
+  drop_finished_tables(*body);
   bodies_.push_back(std::move(body));
   b_ = saved_b;
 

@@ -457,6 +457,7 @@ void Compiler::layout_struct(Type* t, const std::vector<VarDecl>& members, uint3
       align = std::max(align, ft->align);
     }
   }
+  t->fields.shrink_to_fit();
   t->align = std::min<uint32_t>(align, 8);
   t->size = align_up(off, t->align);
   t->init.assign(t->size, 0);
@@ -1205,6 +1206,7 @@ void Compiler::declare_vars(PouInfo* p) {
     for (const auto& s : p->vars)
       if (s->where == Where::Frame || s->where == Where::InOut)
         t->fields.push_back(Field{s->name, s->where == Where::InOut ? tt_->ref_to(s->type) : s->type, s->offset, s->loc});
+    t->fields.shrink_to_fit();  // kept for the whole run: no growth slack
   }
 }
 

@@ -191,6 +191,7 @@ void Parser::parse_call_args(std::vector<CallArg>& args, const std::string& call
     arg.value = parse_expr();
     args.push_back(std::move(arg));
   } while (accept(Tok::Comma));
+  args.shrink_to_fit();  // the tree lives through compilation: no growth slack
   if (!accept(Tok::RParen)) {
     error("ST116", missing_loc(), "expected ',' or ')' in the argument list of '" + callee + "', found " +
                                       describe(cur()));
