@@ -4,7 +4,6 @@
 // standard library only): both execute an instruction with the same code.
 #pragma once
 
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -68,7 +67,7 @@ inline T wmod(T a, T b) {
 }
 template <class T>
 inline T wabs(T a) {
-  if constexpr (std::is_floating_point_v<T>) return std::fabs(a);
+  if constexpr (std::is_floating_point_v<T>) return sizeof(T) == 4 ? __builtin_fabsf(a) : __builtin_fabs(a);
   else if constexpr (std::is_signed_v<T>) return a < 0 ? wneg(a) : a;
   else return a;
 }
@@ -76,7 +75,7 @@ inline T wabs(T a) {
 template <class To, class From>
 inline To cvt(From v) {
   if constexpr (std::is_integral_v<To> && std::is_floating_point_v<From>) {
-    if (std::isnan(v)) return To(0);
+    if (__builtin_isnan(v)) return To(0);
     if (v <= static_cast<From>(std::numeric_limits<To>::min())) return std::numeric_limits<To>::min();
     if (v >= static_cast<From>(std::numeric_limits<To>::max())) return std::numeric_limits<To>::max();
     return static_cast<To>(v);
@@ -115,7 +114,15 @@ inline T ror(T v, uint64_t n) {
 // under the default rounding mode, which plcfi never changes.
 template <class T>
 inline T round_even(T v) {
-  return std::nearbyint(v);
+  if constexpr (sizeof(T) == 4) return __builtin_nearbyintf(v);
+  else return __builtin_nearbyint(v);
+}
+// REAL/LREAL towards zero. The compiler's built-ins, not <cmath>: the native tier's
+// generated code includes this file, and <cmath> alone doubles a small unit's compile.
+template <class T>
+inline T trunc_real(T v) {
+  if constexpr (sizeof(T) == 4) return __builtin_truncf(v);
+  else return __builtin_trunc(v);
 }
 inline float f32_bits(uint32_t b) {
   float f;
