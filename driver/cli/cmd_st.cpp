@@ -7,6 +7,8 @@
 #include <map>
 #include <optional>
 
+#include <unistd.h>
+
 #include <boost/program_options.hpp>
 #include <fmt/format.h>
 
@@ -54,14 +56,20 @@ Json json_value(const st::Machine& m, const st::VarHandle& h) {
 
 std::unique_ptr<st::NativeCode> load_native(const st::Application& app, const char* who) {
   std::string err;
-  auto nc = st::NativeCode::build(app, st::NativeOptions{}, &err);
+  st::NativeOptions no;
+  no.progress = ::isatty(2) != 0;  // a long compile shows how far it got
+  auto nc = st::NativeCode::build(app, no, &err);
   if (!nc) {
     std::cerr << who << ": " << err << "\n";
     return nullptr;
   }
+  std::string how = nc->from_cache() ? "from the cache" : fmt::format("compiled in {:.2f} s", nc->compile_seconds());
+  if (nc->units() > 1 && !nc->from_cache())
+    how += nc->units_compiled() == nc->units()
+               ? fmt::format(" ({} units)", nc->units())
+               : fmt::format(" ({} of {} units, the rest from the cache)", nc->units_compiled(), nc->units());
   std::cerr << fmt::format("{}: native tier: {} function(s){}, {}\n", who, nc->functions(),
-                           nc->interpreted() ? fmt::format(", {} left to the interpreter", nc->interpreted()) : "",
-                           nc->from_cache() ? "from the cache" : fmt::format("compiled in {:.2f} s", nc->compile_seconds()));
+                           nc->interpreted() ? fmt::format(", {} left to the interpreter", nc->interpreted()) : "", how);
   return nc;
 }
 

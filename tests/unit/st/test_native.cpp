@@ -11,6 +11,8 @@
 #include <regex>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "engine.hpp"
 #include "native/native.hpp"
 #include "same_memory.hpp"
@@ -31,13 +33,14 @@ struct Pair {
   std::unique_ptr<NativeCode> native;
 };
 
-Pair build_both(const std::vector<std::pair<std::string, std::string>>& sources, CompileOptions opt = {}) {
+Pair build_both(const std::vector<std::pair<std::string, std::string>>& sources, CompileOptions opt = {},
+                const NativeOptions& no = {}) {
   Pair p;
   p.b = build_sources(sources, opt);
   EXPECT_TRUE(p.b->ok()) << p.b->diags.render_all();
   if (!p.b->ok()) return p;
   std::string err;
-  p.native = NativeCode::build(*p.b->app, NativeOptions{}, &err);
+  p.native = NativeCode::build(*p.b->app, no, &err);
   EXPECT_TRUE(p.native) << err;
   if (p.native) {
     EXPECT_EQ(p.native->interpreted(), 0u);
@@ -169,7 +172,7 @@ END_PROGRAM
   std::string code = native_source(app, &entries, &skipped);
   const PouInfo* main = app.programs.at(0).pou;
   const uint64_t temps = (uint64_t{main->const_from} + main->consts.size() + 7) & ~uint64_t{7};
-  std::regex store(R"(st<\w+>\(base \+ (\d+)u)");
+  std::regex store(R"(ST\(\w+, base \+ (\d+)u)");
   int stores = 0;
   for (auto it = std::sregex_iterator(code.begin(), code.end(), store); it != std::sregex_iterator(); ++it) {
     ++stores;
@@ -264,7 +267,7 @@ TEST(NativeTier, DirectCallsKeepDepthTrapsAndTheWatchdogExact) {
   // The leaf calls took the direct path.
   std::vector<uint32_t> entries, skipped;
   std::string src = native_source(app, &entries, &skipped);
-  EXPECT_NE(src.find("} else { int r = f"), std::string::npos) << "no direct call in the generated code";
+  EXPECT_NE(src.find("} else { int r = F"), std::string::npos) << "no direct call in the generated code";
 }
 
 // Slots the native code keeps in locals (write-through) must be re-read wherever
@@ -326,6 +329,34 @@ TEST(NativeTier, CachedSlotsAreReadAgainAfterEveryOtherWrite) {
   // p.a = 10, x = 2, trigger cleared, k: 1+3=4 -> 5, 6+3=9 -> 10, ... Bump results 4+9+14+19,
   // k = 20, z = 1, arr[1] = 1.
   EXPECT_EQ(read_int(n, *y), 10 + 2 + (4 + 9 + 14 + 19) + 1 + 1 + 20);
+}
+
+// Functions longer than chunk_instructions are compiled as pieces that hand control to
+// each other (loops, CASE tables and calls across the cuts): cut every few instructions,
+// programs of every kind scan as in the interpreter, traps and the watchdog included.
+TEST(NativeTier, LongFunctionsAreCompiledInPieces) {
+  NativeOptions no;
+  no.chunk_instructions = 7;
+  no.optimize = "-O1";
+  no.cache_dir = ::testing::TempDir() + "plcfi_native_pieces";
+  std::vector<std::pair<std::string, std::string>> files = {
+      {"stamping.st", std::string(PLCFI_SOURCE_DIR) + "/st_programs/stamping/stamping.st"}};
+  for (const char* k : {"crc16_parity", "str_build", "enum_fsm", "int_nested", "struct_sort", "fb_timers", "int_while"})
+    files.emplace_back(std::string(k) + ".st", std::string(PLCFI_SOURCE_DIR) + "/tests/bench/matiec31/" + k + ".st");
+  for (const auto& [name, path] : files) {
+    SCOPED_TRACE(name);
+    Pair p = build_both({{name, read_file(path)}}, {}, no);
+    ASSERT_TRUE(p.native);
+    EXPECT_EQ(compare_runs(p, 20, 10'000'000), -1);
+    NativeProgram np = native_program(*p.b->app, 0, no.chunk_instructions);
+    EXPECT_NE(np.units.at(0).text.find("_1(Ctx* c, uint8_t* base, uint32_t* at)"), std::string::npos) << "not cut";
+  }
+  CompileOptions opt;
+  opt.dialect = Dialect::Codesys;
+  Pair calls = build_both({{"calls.st", kCallKinds}}, opt, no);
+  ASSERT_TRUE(calls.native);
+  EXPECT_GE(compare_runs(calls, 12, 50'000), 0);  // a trap, the same in both tiers
+  std::filesystem::remove_all(no.cache_dir);
 }
 
 // Each program traps on its 3rd scan; both tiers must report the same trap.
@@ -437,6 +468,60 @@ TEST_P(NativeMutations, GiveTheSameResultsInBothTiers) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shards, NativeMutations, ::testing::Range(0, 4));
+
+// A program over the split size is compiled as several units, each cached on its own:
+// the same results as the interpreter (traps at the same place, the same coverage), and
+// after an edit to one FB's body, which moves the code and the branch ids of everything
+// after it, only that FB's unit and the index are compiled again.
+std::string units_program(bool edited) {
+  std::string src = "FUNCTION_BLOCK First\nVAR_INPUT go : BOOL; END_VAR\nVAR_OUTPUT n : DINT; END_VAR\n"
+                    "IF go THEN n := n + 1; END_IF;\n";
+  if (edited) src += "IF go THEN n := n + 1; END_IF;\n";  // more code, one more branch
+  src += "END_FUNCTION_BLOCK\n";
+  for (int k = 0; k < 12; ++k)
+    src += fmt::format(
+        "FUNCTION_BLOCK Leaf{0}\nVAR_INPUT d : DINT; END_VAR\nVAR_OUTPUT q : DINT; END_VAR\nVAR acc : DINT; END_VAR\n"
+        "IF d > {0} THEN acc := acc + d; ELSE acc := acc - 1; END_IF;\nq := acc MOD 97;\nEND_FUNCTION_BLOCK\n",
+        k);
+  src += "FUNCTION Ratio : DINT\nVAR_INPUT a, b : DINT; END_VAR\nRatio := a / b;\nEND_FUNCTION\n";
+  src += "PROGRAM Main\nVAR f : First; r : DINT; t : DINT; sum : DINT;\n";
+  for (int k = 0; k < 12; ++k) src += fmt::format("l{} : Leaf{};\n", k, k);
+  src += "END_VAR\nt := t + 1;\nf(go := TRUE);\nsum := 0;\n";
+  for (int k = 0; k < 12; ++k) src += fmt::format("l{0}(d := t + {0});\nsum := sum + l{0}.q;\n", k);
+  src += "r := Ratio(a := sum, b := 40 - t);\nEND_PROGRAM\n";  // divides by zero in scan 40
+  return src;
+}
+
+TEST(NativeTier, LargeProgramsCompileInUnitsCachedOneByOne) {
+  NativeOptions no;
+  no.split_bytes = 1;  // this small program as if it were large
+  no.cache_dir = ::testing::TempDir() + "plcfi_native_units";
+  std::filesystem::remove_all(no.cache_dir);
+  Pair p = build_both({{"units.st", units_program(false)}}, {}, no);
+  ASSERT_TRUE(p.native);
+  EXPECT_GE(p.native->units(), 3u);  // at least two units of functions and the index
+  EXPECT_EQ(p.native->units_compiled(), p.native->units());
+  EXPECT_EQ(compare_runs(p, 60), 39);  // the division by zero, at the same place in both tiers
+
+  Pair e = build_both({{"units.st", units_program(true)}}, {}, no);
+  ASSERT_TRUE(e.native);
+  EXPECT_FALSE(e.native->from_cache());
+  EXPECT_EQ(e.native->units_compiled(), 2u) << "the edited FB's unit and the index";
+  EXPECT_EQ(compare_runs(e, 60), 39);
+
+  // Only that unit's text changed: names and positions are relative.
+  NativeProgram a = native_program(*p.b->app, 1, no.chunk_instructions), b = native_program(*e.b->app, 1, no.chunk_instructions);
+  ASSERT_TRUE(a.split && b.split);
+  ASSERT_EQ(a.units.size(), b.units.size());
+  int changed = 0;
+  for (size_t k = 0; k + 1 < a.units.size(); ++k) changed += a.units[k].text != b.units[k].text;
+  EXPECT_EQ(changed, 1);
+
+  Pair again = build_both({{"units.st", units_program(true)}}, {}, no);
+  ASSERT_TRUE(again.native);
+  EXPECT_TRUE(again.native->from_cache());
+  std::filesystem::remove_all(no.cache_dir);
+}
 
 TEST(NativeTier, MissingCompilerIsAClearError) {
   auto b = build_sources({{"p.st", "PROGRAM P\nVAR x : INT; END_VAR\nx := x + 1;\nEND_PROGRAM\n"}}, CompileOptions{});
