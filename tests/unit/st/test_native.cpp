@@ -11,6 +11,8 @@
 #include <regex>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "engine.hpp"
@@ -338,7 +340,7 @@ TEST(NativeTier, LongFunctionsAreCompiledInPieces) {
   NativeOptions no;
   no.chunk_instructions = 7;
   no.optimize = "-O1";
-  no.cache_dir = ::testing::TempDir() + "plcfi_native_pieces";
+  no.cache_dir = ::testing::TempDir() + "plcfi_native_pieces." + std::to_string(::getpid());
   std::vector<std::pair<std::string, std::string>> files = {
       {"stamping.st", std::string(PLCFI_SOURCE_DIR) + "/st_programs/stamping/stamping.st"}};
   for (const char* k : {"crc16_parity", "str_build", "enum_fsm", "int_nested", "struct_sort", "fb_timers", "int_while"})
@@ -495,7 +497,7 @@ std::string units_program(bool edited) {
 TEST(NativeTier, LargeProgramsCompileInUnitsCachedOneByOne) {
   NativeOptions no;
   no.split_bytes = 1;  // this small program as if it were large
-  no.cache_dir = ::testing::TempDir() + "plcfi_native_units";
+  no.cache_dir = ::testing::TempDir() + "plcfi_native_units." + std::to_string(::getpid());
   std::filesystem::remove_all(no.cache_dir);
   Pair p = build_both({{"units.st", units_program(false)}}, {}, no);
   ASSERT_TRUE(p.native);
