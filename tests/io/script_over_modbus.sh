@@ -98,7 +98,9 @@ set +e
 s=$?
 set -e
 cat "$work/fault.txt"
-grep -q "waited 20 cycle(s) through a communication error, it never held" "$work/fault.txt"
+# The wait ends when the scan clock passes 200 ms: 20 cycles of 10 ms, one or more fewer
+# when cycles started late (a loaded machine, a sanitizer build).
+grep -Eq "waited (1[0-9]|20) cycle\(s\) through a communication error, it never held" "$work/fault.txt"
 grep -q "communication: [1-9][0-9]* exchange(s) failed" "$work/fault.txt"
 stop_server
 
