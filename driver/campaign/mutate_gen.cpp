@@ -78,7 +78,7 @@ std::vector<OperandRef> operand_refs(st::Op op) {
         if ((c != 'R' && c != 'M') || (p > 0 && std::isalnum(static_cast<unsigned char>(rtl[p - 1])))) continue;
         size_t q = p + 1;
         while (q < rtl.size() && (std::isdigit(static_cast<unsigned char>(rtl[q])) || rtl[q] == 'f')) ++q;
-        if (q + 2 >= rtl.size() || rtl[q] != '[' || rtl[q + 2] != ']' || rtl[q + 1] < 'a' || rtl[q + 1] > 'g') continue;
+        if (q + 2 >= rtl.size() || rtl[q] != '[' || rtl[q + 2] != ']' || rtl[q + 1] < 'a' || rtl[q + 1] > 'k') continue;
         bool dest = assign != std::string::npos && p < assign && rtl.compare(0, 3, "if ") != 0 &&
                     (p == 0 || (bit_store && p == rtl.find(c == 'R' ? " of R" : " of M") + 4));
         cache[k].push_back({c, rtl[q + 1] - 'a' + 1, dest});
@@ -101,13 +101,15 @@ std::string op_name(st::Op op) { return st::op_info(op).name; }
 bool is_cond_jump(st::Op op) {
   std::string n = op_name(op);
   return n == "JMPF" || n == "JMPT" || n.rfind("JLT_", 0) == 0 || n.rfind("JGE_", 0) == 0 || n.rfind("JEQ_", 0) == 0 ||
-         n.rfind("JNE_", 0) == 0 || n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0;
+         n.rfind("JNE_", 0) == 0 || n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0 || n.rfind("JTZ_", 0) == 0 ||
+         n.rfind("JTNZ_", 0) == 0;
 }
 st::Op negated_jump(st::Op op) {
   std::string n = op_name(op);
   static const std::pair<const char*, const char*> swaps[] = {{"JMPF", "JMPT"}, {"JMPT", "JMPF"}, {"JLT_", "JGE_"},
                                                              {"JGE_", "JLT_"}, {"JEQ_", "JNE_"}, {"JNE_", "JEQ_"},
-                                                             {"JNLT_", "JLT_"}, {"JNGE_", "JGE_"}};
+                                                             {"JNLT_", "JLT_"}, {"JNGE_", "JGE_"}, {"JTZ_", "JTNZ_"},
+                                                             {"JTNZ_", "JTZ_"}};
   for (auto [from, to] : swaps)
     if (n.rfind(from, 0) == 0) return ops_by_name().at(to + n.substr(std::strlen(from)));
   return op;

@@ -109,6 +109,12 @@ struct Place {
   uint32_t idx_cvt = UINT32_MAX;  // FrameIdx: where this place emitted the conversion of its index to DINT
   bool has_idx16 = false;  // FrameIdx: idx not made yet; the index is the INT variable idx16 (stores: STXH)
   Slot idx16;
+  // FrameIdx with a second variable index (LDXX/STXX): stride is the first index's,
+  // these the second's.
+  bool two = false;
+  Slot idx2;
+  int32_t lo2 = 0;
+  uint32_t count2 = 0, stride2 = 0;
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -141,6 +147,7 @@ struct Body {
   Slot last_def;
   uint32_t last_label_pos = 0;
   uint32_t last_instr = UINT32_MAX;
+  uint32_t prev_instr = UINT32_MAX;  // the instruction before last_instr, while both stand
   // Conversions already done in the statement being compiled (an index used twice).
   std::map<std::tuple<uint32_t, SK, Storage, Storage>, Slot> cvt_cache;
   std::unordered_map<std::string, Symbol*> locals;  // canon name -> symbol (frame or This)
@@ -310,6 +317,7 @@ class Compiler {
   // just computed into a temporary becomes one fused compare-and-jump instruction.
   // (Defined in stmt.cpp.)
   void branch_on(const Val& c, SourceLoc loc, Label target, bool when_true);
+  bool test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero);
   Val bad() {
     Val v;
     v.ok = false;

@@ -458,9 +458,12 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     dyn.emplace_back(i, convert(v.slot, v.type, elem(TypeKind::DInt)));
     if (b_->code.size() != before) idx_cvt = b_->last_instr;
   }
-  bool fast = dyn.size() == 1 && base.k == Place::K::Frame && t->dims.size() == 1 &&
-              ((t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) ||
-               t->elem->kind == TypeKind::Struct || t->elem->kind == TypeKind::Pou);
+  // Fast path: one or two variable indices into a frame array, of any rank, of scalars or
+  // of structures (whose scalar fields are then reached in one instruction). The constant
+  // indices make a fixed offset into the element's row.
+  const bool fast = (dyn.size() == 1 || dyn.size() == 2) && base.k == Place::K::Frame &&
+                    ((t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) ||
+                     t->elem->kind == TypeKind::Struct || t->elem->kind == TypeKind::Pou);
   if (raw16 && !fast) dyn[0].second = convert(*raw16, elem(TypeKind::Int), elem(TypeKind::DInt));
   if (dyn.empty()) {
     Place p = base;
@@ -469,11 +472,8 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     if (base.k == Place::K::AbsBit || base.k == Place::K::Bit || base.k == Place::K::FrameIdx) return bad_place;
     return p;
   }
-  // Fast path: one variable index into a frame array of scalars or of structures (whose
-  // scalar fields are then reached in one instruction).
-  if (dyn.size() == 1 && base.k == Place::K::Frame && t->dims.size() == 1 &&
-      ((t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) || t->elem->kind == TypeKind::Struct ||
-       t->elem->kind == TypeKind::Pou)) {
+  if (fast) {
+    const size_t d0 = dyn[0].first;
     Place p;
     p.k = Place::K::FrameIdx;
     p.type = t->elem;
@@ -484,9 +484,20 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
       p.has_idx16 = true;
       p.idx16 = *raw16;
     }
-    p.lo = static_cast<int32_t>(t->dims[0].lo);
-    p.count = static_cast<uint32_t>(t->dims[0].hi - t->dims[0].lo + 1);
-    p.stride = t->elem->is_elementary() ? 0 : esize;
+    p.lo = static_cast<int32_t>(t->dims[d0].lo);
+    p.count = static_cast<uint32_t>(t->dims[d0].hi - t->dims[d0].lo + 1);
+    // stride 0: a rank-1 array of scalars (LDX/STX); else the element's or row's size.
+    const bool plain = t->elem->is_elementary() && dyn.size() == 1 && stride[d0] == esize && const_disp == 0;
+    p.stride = plain ? 0 : static_cast<uint32_t>(stride[d0]);
+    p.field = static_cast<uint32_t>(const_disp);
+    if (dyn.size() == 2) {
+      const size_t d1 = dyn[1].first;
+      p.two = true;
+      p.idx2 = dyn[1].second;
+      p.lo2 = static_cast<int32_t>(t->dims[d1].lo);
+      p.count2 = static_cast<uint32_t>(t->dims[d1].hi - t->dims[d1].lo + 1);
+      p.stride2 = static_cast<uint32_t>(stride[d1]);
+    }
     p.idx_cvt = idx_cvt;
     p.readonly = base.readonly;
     return p;
@@ -679,6 +690,11 @@ Slot Compiler::addr_of(const Place& p, SourceLoc loc) {
       emit(Op::ADDR, {a, Slot{p.off, p.sk}});
       Slot t = temp(4, 4);
       emit(Op::ELEM, {t, a, frame_idx(p), static_cast<uint32_t>(p.lo), p.count, p.stride ? p.stride : p.type->size});
+      if (p.two) {
+        Slot t2 = temp(4, 4);
+        emit(Op::ELEM, {t2, t, p.idx2, static_cast<uint32_t>(p.lo2), p.count2, p.stride2});
+        t = t2;
+      }
       if (p.field == 0) return t;
       Slot f = temp(4, 4);
       emit(Op::ADDRI, {f, t, p.field});
@@ -700,7 +716,7 @@ Val Compiler::load_once(const Place& p) {
   auto& code = b_->code;
   uint32_t at = b_->last_instr;
   uint32_t size = p.ok && p.type ? p.type->size : 0;
-  if (!p.ok || p.k != Place::K::FrameIdx || p.has_idx16 || !p.type->is_elementary() || !(size == 1 || size == 2 || size == 4 || size == 8) ||
+  if (!p.ok || p.k != Place::K::FrameIdx || p.has_idx16 || p.two || !p.type->is_elementary() || !(size == 1 || size == 2 || size == 4 || size == 8) ||
       at >= code.size() || p.idx_cvt != at || code[at] != static_cast<uint32_t>(Op::CVT_I16_I32) || b_->last_def_pos != at ||
       b_->last_label_pos > at || b_->last_def.kind != SK::Temp || p.idx.kind != SK::Temp || b_->last_def.off != p.idx.off ||
       (!b_->lines.empty() && b_->lines.back().first > at))
@@ -747,6 +763,14 @@ Val Compiler::load(const Place& p) {
     return bad();
   }
   if (p.k == Place::K::FrameIdx && !p.type->is_elementary()) {
+    if (!p.two) {
+      // A whole element (a structure, an FB instance) as one block.
+      Slot t = temp_for(p.type);
+      emit(Op::LDXB, {t, Slot{p.off, p.sk}, frame_idx(p), static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, p.type->size});
+      def(t);
+      v.slot = t;
+      return v;
+    }
     Place ind = p;
     ind.k = Place::K::Ind;
     ind.ptr = addr_of(p, SourceLoc{});
@@ -792,7 +816,11 @@ Val Compiler::load(const Place& p) {
     case Place::K::FrameIdx: {
       Slot idx = frame_idx(p);
       Slot t = temp_for(p.type);
-      if (p.stride) {
+      if (p.two) {
+        Op op = size == 1 ? Op::LDXX1 : size == 2 ? Op::LDXX2 : size == 4 ? Op::LDXX4 : Op::LDXX8;
+        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
+                  p.count2, p.stride2, p.field});
+      } else if (p.stride) {
         Op op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
         emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
       } else {
@@ -820,6 +848,10 @@ Val Compiler::load(const Place& p) {
 void Compiler::store(const Place& p, Slot src) {
   const Type* t = p.type;
   if (p.k == Place::K::FrameIdx && !t->is_elementary()) {
+    if (!p.two) {
+      emit(Op::STXB, {Slot{p.off, p.sk}, frame_idx(p), static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src, t->size});
+      return;
+    }
     Place ind = p;
     ind.k = Place::K::Ind;
     ind.ptr = addr_of(p, SourceLoc{});
@@ -865,6 +897,12 @@ void Compiler::store(const Place& p, Slot src) {
         default: emit(Op::STIN, {p.ptr, p.off, src, size}); return;
       }
     case Place::K::FrameIdx: {
+      if (p.two) {
+        Op op = size == 1 ? Op::STXX1 : size == 2 ? Op::STXX2 : size == 4 ? Op::STXX4 : Op::STXX8;
+        emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
+                  p.stride2, p.field, src});
+        return;
+      }
       if (p.has_idx16 && p.stride) {
         Op op = size == 1 ? Op::STXSH1 : size == 2 ? Op::STXSH2 : size == 4 ? Op::STXSH4 : Op::STXSH8;
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});

@@ -35,6 +35,48 @@ struct ArmScope {
 };
 }  // namespace
 
+// A test of bits: "AND t, x, m; EQ/NE c, t, 0" compiled into a jump is one JTZ or JTNZ
+// on x and m, when the AND is the instruction right before the comparison, in the same
+// statement line and block, and defines a temporary only the comparison reads. `if_zero`:
+// the jump is to be taken when the AND gives zero. False: nothing changed.
+bool Compiler::test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero) {
+  auto& code = b_->code;
+  const uint32_t and_at = b_->prev_instr;
+  if (and_at == UINT32_MAX || and_at >= cmp_at || and_at < b_->last_label_pos || type_idx >= 8) return false;
+  constexpr uint32_t stride = static_cast<uint32_t>(Op::MOD_I16) - static_cast<uint32_t>(Op::MOD_I8);
+  if (code[and_at] != static_cast<uint32_t>(Op::AND_I8) + type_idx * stride || and_at + 4 != cmp_at) return false;
+  if (!b_->lines.empty() && b_->lines.back().first > and_at) return false;
+  static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8};
+  auto kind_at = [&](uint32_t word) {
+    for (const auto& [w, k] : b_->slot_fix)
+      if (w == word) return k;
+    return SK::Var;
+  };
+  auto zero = [&](uint32_t word) {
+    if (kind_at(word) != SK::Const || code[word] + kWidth[type_idx] > b_->consts.size()) return false;
+    for (uint32_t i = 0; i < kWidth[type_idx]; ++i)
+      if (b_->consts[code[word] + i] != 0) return false;
+    return true;
+  };
+  // The comparison reads the AND's temporary and a constant zero, in either order.
+  const uint32_t t = code[and_at + 1];
+  if (kind_at(and_at + 1) != SK::Temp) return false;
+  const bool t_first = code[cmp_at + 2] == t && kind_at(cmp_at + 2) == SK::Temp && zero(cmp_at + 3);
+  const bool t_second = code[cmp_at + 3] == t && kind_at(cmp_at + 3) == SK::Temp && zero(cmp_at + 2);
+  if (!t_first && !t_second) return false;
+  Arg x(code[and_at + 2]), y(code[and_at + 3]);
+  for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
+    if (it->first == and_at + 2) x = Arg(Slot{code[and_at + 2], it->second});
+    if (it->first == and_at + 3) y = Arg(Slot{code[and_at + 3], it->second});
+    if (it->first >= and_at) it = b_->slot_fix.erase(it);
+    else ++it;
+  }
+  code.resize(and_at);
+  emit(int_op(if_zero ? Op::JTZ_I8 : Op::JTNZ_I8, static_cast<Storage>(type_idx)), {Arg::target(target.id), x, y});
+  b_->last_def_pos = UINT32_MAX;
+  return true;
+}
+
 void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_true) {
   Slot cs = to_slot(c, elem(TypeKind::Bool), loc);
   // Peephole: "CMP t, a, b; JMPF target, t" -> "J<inverse> target, a, b".
@@ -94,6 +136,8 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
           fj = lt ? (f64 ? Op::JNLT_F64 : Op::JNLT_F32) : (f64 ? Op::JNGE_F64 : Op::JNGE_F32);
           swap = m.cmp == Op::GT_I8 || m.cmp == Op::LE_I8;
         }
+        if (!is_float && (m.cmp == Op::EQ_I8 || m.cmp == Op::NE_I8) && test_bits(at, type_idx, target, m.cmp == Op::EQ_I8 ? when_true : !when_true))
+          return;
         Arg a(code[at + 2]), b2(code[at + 3]);
         for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
           if (it->first == at + 2) a = Arg(Slot{code[at + 2], it->second});
@@ -648,40 +692,51 @@ void Compiler::for_stmt(const ForStmt& s) {
   bind(exit);
 }
 
+// WHILE and REPEAT test at the bottom: one conditional jump back per iteration instead of
+// a test and a jump (the VM and the native tier count a conditional jump back against the
+// watchdog, as JMPB). WHILE tests once more on entry, with its own copy of the condition,
+// so its coverage id is set once per entry into a loop that runs, not per iteration.
 void Compiler::while_stmt(const WhileStmt& s) {
-  Label top = new_label(), exit = new_label();
-  bind(top);
+  Label body = new_label(), test = new_label(), exit = new_label();
   uint32_t saved = b_->temp_top;
   Val c = cond(*s.cond);
-  if (c.ok) branch_on(c, s.cond->loc, exit, false);
+  if (!c.ok) return;
+  branch_on(c, s.cond->loc, exit, false);
   b_->temp_top = saved;
-  b_->loops.push_back({exit, top});
   uint32_t decision = kNoBranch;
   {
     ArmScope in(b_, branch(s.loc, "WHILE", s.loc, &decision, s.body));
+    bind(body);
+    b_->loops.push_back({exit, test});
     stmts(s.body);
+    b_->loops.pop_back();
   }
-  b_->loops.pop_back();
-  emit(Op::JMPB, {Arg::target(top.id)});
+  bind(test);
+  mark(s.cond->loc);
+  c = cond(*s.cond);
+  if (c.ok) branch_on(c, s.cond->loc, body, true);
+  b_->temp_top = saved;
   bind(exit);
 }
 
 void Compiler::repeat_stmt(const RepeatStmt& s) {
-  Label top = new_label(), cont = new_label(), exit = new_label();
-  bind(top);
+  Label body = new_label(), cont = new_label(), exit = new_label();
   b_->loops.push_back({exit, cont});
   uint32_t decision = kNoBranch;
   {
     ArmScope in(b_, branch(s.loc, "REPEAT", s.loc, &decision, s.body));
+    bind(body);
     stmts(s.body);
   }
   b_->loops.pop_back();
   bind(cont);
   if (s.until) {
+    mark(s.until->loc);
     Val c = cond(*s.until);
-    if (c.ok) branch_on(c, s.until->loc, exit, true);
+    if (c.ok) branch_on(c, s.until->loc, body, false);
+  } else {
+    emit(Op::JMPB, {Arg::target(body.id)});
   }
-  emit(Op::JMPB, {Arg::target(top.id)});
   bind(exit);
 }
 

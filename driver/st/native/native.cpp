@@ -97,7 +97,8 @@ void jump_targets(const uint32_t* w, std::vector<uint32_t>* out) {
   std::string_view n = op_info(op).name;
   if (n.size() > 4 && (n.substr(0, 4) == "JLT_" || n.substr(0, 4) == "JGE_" || n.substr(0, 4) == "JEQ_" || n.substr(0, 4) == "JNE_"))
     out->push_back(w[1]);
-  if (n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0) out->push_back(w[1]);
+  if (n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0 || n.rfind("JTZ_", 0) == 0 || n.rfind("JTNZ_", 0) == 0)
+    out->push_back(w[1]);
   if (n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) out->push_back(w[4]);
 }
 
@@ -403,12 +404,25 @@ class Translator {
         {"SHL", TypedFamily::kNever},    {"SHR", TypedFamily::kNever},    {"ROL", TypedFamily::kNever},
         {"ROR", TypedFamily::kNever},    {"CHK", TypedFamily::kAlways},   {"LOOPUP", TypedFamily::kAlways},
         {"LOOPDN", TypedFamily::kAlways}, {"ROUND", TypedFamily::kNever}, {"TRUNC", TypedFamily::kNever},
+        {"JTZ", TypedFamily::kNever},    {"JTNZ", TypedFamily::kNever},
     };
     size_t us = op_name.find('_');
     if (us == std::string_view::npos) return nullptr;
     for (const TypedFamily& f : kFamilies)
       if (op_name.substr(0, us) == f.name) return &f;
     return nullptr;
+  }
+
+  // A jump that counts against the watchdog: JMPB, a counted loop's step, or a conditional
+  // jump to an earlier instruction (WHILE and REPEAT test at the bottom).
+  bool back_edge(uint32_t pc) const {
+    auto op = static_cast<Op>(code_[pc]);
+    std::string_view n = op_info(op).name;
+    if (op == Op::JMPB || n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) return true;
+    bool conditional = op == Op::JMPF || op == Op::JMPT || n.rfind("JLT_", 0) == 0 || n.rfind("JGE_", 0) == 0 ||
+                       n.rfind("JEQ_", 0) == 0 || n.rfind("JNE_", 0) == 0 || n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0 ||
+                       n.rfind("JTZ_", 0) == 0 || n.rfind("JTNZ_", 0) == 0;
+    return conditional && code_[pc + 1] <= pc;
   }
 
   void summarize() {
@@ -419,7 +433,6 @@ class Translator {
       for (uint32_t pc = e; pc < end; pc += op_length(&code_[pc])) {
         auto op = static_cast<Op>(code_[pc]);
         last = op;
-        std::string_view n = op_info(op).name;
         uint32_t t = 0;
         if (op == Op::CALL || op == Op::CALLA || op == Op::CALLS) {
           call_target(&code_[pc], &t);
@@ -428,7 +441,7 @@ class Translator {
         } else if (op == Op::CALLV || op == Op::CALLP) {
           sm.simple = false;
         }
-        if (op == Op::JMPB || n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) sm.loops = true;
+        if (back_edge(pc)) sm.loops = sm.fails = true;
         if (op == Op::ENTER) sm.methods = true;
         if (!never_fails(op) || (op == Op::NATIVE && native_traps(code_[pc + 1] & 0xffffu))) sm.fails = true;
       }
@@ -554,10 +567,7 @@ class Translator {
     // The watchdog budget lives in a local only in a function with loops of its own;
     // elsewhere c->budget is always current and needs no copying around calls.
     bool own_loops = false;
-    for (uint32_t pc = start; pc < end; pc += op_length(&code_[pc])) {
-      std::string_view n = op_info(static_cast<Op>(code_[pc])).name;
-      if (static_cast<Op>(code_[pc]) == Op::JMPB || n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) own_loops = true;
-    }
+    for (uint32_t pc = start; pc < end; pc += op_length(&code_[pc])) own_loops = own_loops || back_edge(pc);
     // A very long function (a large PROGRAM body) is cut into pieces of at most
     // chunk_instructions_ instructions, so the C++ compiler, whose time grows faster
     // than a function's length, sees several functions of moderate size. The pieces
@@ -710,6 +720,8 @@ class Translator {
     auto G = [&](int i) { return fmt::format("mem + {}u", w[i]); };
     auto jump = [&](int i) { return go(w[i]); };
     auto backjump = [&]() { return fmt::format("if (--budget < 0) TRAP(5, {}, 0, 0, 0); ", P(pc)); };
+    // A conditional jump back is a loop's back edge: it counts against the watchdog.
+    auto cjump = [&](int i) { return w[i] <= pc ? "{ " + backjump() + go(w[i]) + " }" : go(w[i]); };
     // The address in slot i plus disp, checked for null and bounds of n bytes.
     // Through a pointer proven to stay inside a frame array (see `provenance`), neither
     // check can fail and both are left out.
@@ -728,8 +740,8 @@ class Translator {
       case Op::RET: s = "FLUSH(); BUDGET_OUT(); return kOk;"; return true;
       case Op::JMP: s = jump(1); return true;
       case Op::JMPB: s = backjump() + jump(1); return true;
-      case Op::JMPF: s = fmt::format("if (!{}) {}", R("uint8_t", 2), jump(1)); return true;
-      case Op::JMPT: s = fmt::format("if ({}) {}", R("uint8_t", 2), jump(1)); return true;
+      case Op::JMPF: s = fmt::format("if (!{}) {}", R("uint8_t", 2), cjump(1)); return true;
+      case Op::JMPT: s = fmt::format("if ({}) {}", R("uint8_t", 2), cjump(1)); return true;
       case Op::CALL: s = direct_call(pc, w[2], fmt::format("base + {}u", w[1])); return true;
       case Op::CALLA: s = direct_call(pc, w[2], G(1)); return true;
       case Op::CALLP:
@@ -888,12 +900,42 @@ class Translator {
       case Op::JNGE_F64: {
         const char* t = op == Op::JNLT_F32 || op == Op::JNGE_F32 ? "float" : "double";
         const char* rel = op == Op::JNLT_F32 || op == Op::JNLT_F64 ? "<" : ">=";
-        s = fmt::format("if (!({} {} {})) {}", R(t, 2), rel, R(t, 3), jump(1));
+        s = fmt::format("if (!({} {} {})) {}", R(t, 2), rel, R(t, 3), cjump(1));
         return true;
       }
       default: break;
     }
     std::string_view name = op_info(op).name;
+    // Rank-2 frame arrays: two indices, checked in order (TRAP's b says which failed).
+    if (name.rfind("LDXX", 0) == 0 || name.rfind("STXX", 0) == 0) {
+      int n = name.back() - '0';
+      const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
+      bool load = name[0] == 'L';
+      int at = load ? 3 : 2;
+      s.clear();
+      for (int d = 0; d < 2; ++d) {
+        int idx = at + 4 * d;
+        s += fmt::format("int64_t i{4} = (int64_t){0} - (int64_t){1}; if (i{4} < 0 || i{4} >= (int64_t){2}) TRAP(2, {3}, {0}, {4}, 0); ",
+                         R("int32_t", idx), S(idx + 1), K(idx + 2), P(pc), d);
+      }
+      std::string addr = fmt::format("base + {} + i0 * {} + i1 * {} + {}", K(at - 1), K(at + 3), K(at + 7), K(at + 8));
+      if (load) s += W(t, 1, fmt::format("ld<{}>({})", t, addr));
+      else s += fmt::format("st<{}>({}, {});", t, addr, R(t, 11));
+      return true;
+    }
+    // Whole structure elements as blocks; a copy that cannot overlap is a memcpy.
+    if (op == Op::LDXB || op == Op::STXB) {
+      bool load = op == Op::LDXB;
+      int at = load ? 3 : 2;
+      uint64_t arr = w[at - 1], arr_n = uint64_t{w[at + 2]} * w[at + 3], blk = load ? w[1] : w[7], n = w[8];
+      const char* fn = blk + n <= arr || arr + arr_n <= blk ? "memcpy" : "memmove";
+      s = fmt::format("int64_t i = (int64_t){0} - (int64_t){1}; if (i < 0 || i >= (int64_t){2}) TRAP(2, {3}, {0}, 0, 0); ",
+                      R("int32_t", at), S(at + 1), K(at + 2), P(pc));
+      std::string elem = fmt::format("base + {} + i * {} + {}", K(at - 1), K(at + 3), K(at + 4));
+      if (load) s += fmt::format("std::{}(base + {}, {}, {});", fn, K(1), elem, K(8));
+      else s += fmt::format("std::{}({}, base + {}, {});", fn, elem, K(7), K(8));
+      return true;
+    }
     // Element access into frame arrays (bounds-checked); an H variant takes an INT index.
     if (name.rfind("LDX", 0) == 0 || name.rfind("STX", 0) == 0) {
       bool structs = name[3] == 'S';
@@ -925,7 +967,7 @@ class Translator {
     if (!C) return false;
     auto bin = [&](const char* f) { s = W(C, 1, fmt::format("({}<{}>({}, {}))", f, C, R(C, 2), R(C, 3))); };
     auto cmp = [&](const char* rel) { s = W("uint8_t", 1, fmt::format("(uint8_t)({} {} {})", R(C, 2), rel, R(C, 3))); };
-    auto cj = [&](const char* rel) { s = fmt::format("if ({} {} {}) {}", R(C, 2), rel, R(C, 3), jump(1)); };
+    auto cj = [&](const char* rel) { s = fmt::format("if ({} {} {}) {}", R(C, 2), rel, R(C, 3), cjump(1)); };
     if (fam == "ADD") bin("wadd");
     else if (fam == "SUB") bin("wsub");
     else if (fam == "MUL") bin("wmul");
@@ -946,6 +988,8 @@ class Translator {
     else if (fam == "JGE") cj(">=");
     else if (fam == "JEQ") cj("==");
     else if (fam == "JNE") cj("!=");
+    else if (fam == "JTZ") s = fmt::format("if (({}) ({} & {}) == 0) {}", C, R(C, 2), R(C, 3), cjump(1));
+    else if (fam == "JTNZ") s = fmt::format("if (({}) ({} & {}) != 0) {}", C, R(C, 2), R(C, 3), cjump(1));
     else if (fam == "MIN") s = fmt::format("{0} x = {1}, y = {2}; ", C, R(C, 2), R(C, 3)) + W(C, 1, "(y < x ? y : x)");
     else if (fam == "MAX") s = fmt::format("{0} x = {1}, y = {2}; ", C, R(C, 2), R(C, 3)) + W(C, 1, "(x < y ? y : x)");
     else if (fam == "ABS") s = W(C, 1, fmt::format("(wabs<{}>({}))", C, R(C, 2)));
@@ -1058,6 +1102,10 @@ class Translator {
     }
     std::string_view n = op_info(op).name;
     // Element writes stay inside their (bounds-checked) array.
+    if (op == Op::LDXB) return range(w[1], w[8]);
+    if (op == Op::STXB) return range(w[1], uint64_t{w[4]} * w[5]);
+    if (n.rfind("STXX", 0) == 0) return range(w[1], uint64_t{w[4]} * w[5]);
+    if (n.rfind("LDXX", 0) == 0) return {};
     if (n.rfind("STXS", 0) == 0) return range(w[1], uint64_t{w[4]} * w[5]);
     if (n.rfind("STX", 0) == 0) return range(w[1], uint64_t{w[4]} * static_cast<uint64_t>(n.back() - '0'));
     if (n.rfind("LDX", 0) == 0) return {};
@@ -1214,6 +1262,10 @@ class Translator {
       default: break;
     }
     std::string_view n = op_info(op).name;
+    if (op == Op::LDXB) return range(w[2], uint64_t{w[5]} * w[6]);
+    if (op == Op::STXB) return range(w[7], w[8]);
+    if (n.rfind("LDXX", 0) == 0) return range(w[2], uint64_t{w[5]} * w[6]);
+    if (n.rfind("STXX", 0) == 0) return {};
     if (n.rfind("LDXS", 0) == 0) return range(w[2], uint64_t{w[5]} * w[6]);
     if (n.rfind("LDX", 0) == 0) return range(w[2], uint64_t{w[5]} * static_cast<uint64_t>(n.back() - '0'));
     if (n.rfind("STX", 0) == 0) return {};

@@ -183,6 +183,9 @@ struct NativeBridge {
         case TrapKind::DivisionByZero: msg = a == 1 ? "MOD by zero" : "integer division by zero"; break;
         case TrapKind::IndexOutOfRange:
           if (name.rfind("CHK_", 0) == 0) msg = fmt::format("index {} outside {}..{}", num(a), num(b), num(cc));
+          // LDXX/STXX: b says which of the two indices is outside.
+          else if (name.rfind("LDXX", 0) == 0) msg = b == 0 ? range(4, 5) : range(8, 9);
+          else if (name.rfind("STXX", 0) == 0) msg = b == 0 ? range(3, 4) : range(7, 8);
           else if (op == Op::ELEM || name.rfind("LDX", 0) == 0) msg = range(4, 5);
           else msg = range(3, 4);  // STX, STXS
           break;
@@ -388,6 +391,17 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
   if (--budget < 0)                                                                             \
     return fail(TrapKind::Watchdog, pc,                                                         \
                 fmt::format("more than {} loop iterations in one call (endless loop?)", budget_limit_))
+  // A taken conditional jump to an earlier instruction is a loop's back edge (WHILE and
+  // REPEAT test at the bottom): it counts against the watchdog, as JMPB does.
+#define TAKE(k)                                  \
+  do {                                           \
+    const uint32_t* const to_ = code + pc[k];    \
+    if (to_ <= pc) {                             \
+      BACKJUMP();                                \
+    }                                            \
+    pc = to_;                                    \
+    DISPATCH();                                  \
+  } while (0)
 
   DISPATCH();
 
@@ -414,16 +428,10 @@ L_JMPB:
   pc = code + pc[1];
   DISPATCH();
 L_JMPF:
-  if (!ld<uint8_t>(base + pc[2])) {
-    pc = code + pc[1];
-    DISPATCH();
-  }
+  if (!ld<uint8_t>(base + pc[2])) TAKE(1);
   NEXT(2);
 L_JMPT:
-  if (ld<uint8_t>(base + pc[2])) {
-    pc = code + pc[1];
-    DISPATCH();
-  }
+  if (ld<uint8_t>(base + pc[2])) TAKE(1);
   NEXT(2);
 L_CALL:
   if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
@@ -617,10 +625,10 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
   L_LE_##TN: W(uint8_t, 1, R(C, 2) <= R(C, 3)); NEXT(3);                                \
   L_GT_##TN: W(uint8_t, 1, R(C, 2) > R(C, 3)); NEXT(3);                                 \
   L_GE_##TN: W(uint8_t, 1, R(C, 2) >= R(C, 3)); NEXT(3);                                \
-  L_JLT_##TN: if (R(C, 2) < R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);        \
-  L_JGE_##TN: if (R(C, 2) >= R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);       \
-  L_JEQ_##TN: if (R(C, 2) == R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);       \
-  L_JNE_##TN: if (R(C, 2) != R(C, 3)) { pc = code + pc[1]; DISPATCH(); } NEXT(3);       \
+  L_JLT_##TN: if (R(C, 2) < R(C, 3)) TAKE(1); NEXT(3);        \
+  L_JGE_##TN: if (R(C, 2) >= R(C, 3)) TAKE(1); NEXT(3);       \
+  L_JEQ_##TN: if (R(C, 2) == R(C, 3)) TAKE(1); NEXT(3);       \
+  L_JNE_##TN: if (R(C, 2) != R(C, 3)) TAKE(1); NEXT(3);       \
   L_MIN_##TN: { C x = R(C, 2), y = R(C, 3); W(C, 1, y < x ? y : x); NEXT(3); }          \
   L_MAX_##TN: { C x = R(C, 2), y = R(C, 3); W(C, 1, x < y ? y : x); NEXT(3); }          \
   L_ABS_##TN: W(C, 1, wabs<C>(R(C, 2))); NEXT(2);                                       \
@@ -650,6 +658,8 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
     NEXT(3);                                                                             \
   }                                                                                      \
   L_AND_##TN: W(C, 1, static_cast<C>(R(C, 2) & R(C, 3))); NEXT(3);                       \
+  L_JTZ_##TN: if ((R(C, 2) & R(C, 3)) == 0) TAKE(1); NEXT(3);                              \
+  L_JTNZ_##TN: if ((R(C, 2) & R(C, 3)) != 0) TAKE(1); NEXT(3);                             \
   L_OR_##TN: W(C, 1, static_cast<C>(R(C, 2) | R(C, 3))); NEXT(3);                        \
   L_XOR_##TN: W(C, 1, static_cast<C>(R(C, 2) ^ R(C, 3))); NEXT(3);                       \
   L_NOT_##TN: W(C, 1, static_cast<C>(~R(C, 2))); NEXT(2);                                \
@@ -721,11 +731,48 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   ELEM_IMPL(H, int16_t, 8, uint64_t)
 #undef ELEM_IMPL
 
+// Rank-2 frame arrays (LDXX/STXX): both indices checked, the first one first, as the
+// ELEM chain they replace checks them.
+#define ELEM_INDEX2(v, k)                                                                       \
+  int64_t v = static_cast<int64_t>(R(int32_t, k)) - static_cast<int32_t>(pc[k + 1]);            \
+  if (v < 0 || v >= static_cast<int64_t>(pc[k + 2]))                                            \
+    return fail(TrapKind::IndexOutOfRange, pc,                                                  \
+                fmt::format("index {} outside {}..{}", R(int32_t, k), static_cast<int32_t>(pc[k + 1]), \
+                            static_cast<int64_t>(static_cast<int32_t>(pc[k + 1])) + pc[k + 2] - 1));
+#define ELEM2_IMPL(N, T)                                                                        \
+  L_LDXX##N: {                                                                                  \
+    ELEM_INDEX2(i0, 3) ELEM_INDEX2(i1, 7)                                                       \
+    W(T, 1, ld<T>(base + pc[2] + i0 * pc[6] + i1 * pc[10] + pc[11]));                           \
+    NEXT(11);                                                                                   \
+  }                                                                                             \
+  L_STXX##N: {                                                                                  \
+    ELEM_INDEX2(i0, 2) ELEM_INDEX2(i1, 6)                                                       \
+    st<T>(base + pc[1] + i0 * pc[5] + i1 * pc[9] + pc[10], R(T, 11));                           \
+    NEXT(11);                                                                                   \
+  }
+  ELEM2_IMPL(1, uint8_t)
+  ELEM2_IMPL(2, uint16_t)
+  ELEM2_IMPL(4, uint32_t)
+  ELEM2_IMPL(8, uint64_t)
+#undef ELEM2_IMPL
+  // Whole elements of structure arrays, copied as blocks (memmove, as LDIN/STIN do).
+L_LDXB: {
+  ELEM_INDEX2(i, 3)
+  std::memmove(base + pc[1], base + pc[2] + i * pc[6] + pc[7], pc[8]);
+  NEXT(8);
+}
+L_STXB: {
+  ELEM_INDEX2(i, 2)
+  std::memmove(base + pc[1] + i * pc[5] + pc[6], base + pc[7], pc[8]);
+  NEXT(8);
+}
+#undef ELEM_INDEX2
+
 // Float compare-and-jump, taken when the comparison fails (NaN included).
-L_JNLT_F32: if (!(R(float, 2) < R(float, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
-L_JNGE_F32: if (!(R(float, 2) >= R(float, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
-L_JNLT_F64: if (!(R(double, 2) < R(double, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
-L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) { pc = code + pc[1]; DISPATCH(); } NEXT(3);
+L_JNLT_F32: if (!(R(float, 2) < R(float, 3))) TAKE(1); NEXT(3);
+L_JNGE_F32: if (!(R(float, 2) >= R(float, 3))) TAKE(1); NEXT(3);
+L_JNLT_F64: if (!(R(double, 2) < R(double, 3))) TAKE(1); NEXT(3);
+L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); NEXT(3);
 
 #define DIVK_IMPL(NAME, T, IS_MOD)                                                      \
   L_##NAME: {                                                                           \
@@ -762,7 +809,7 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) { pc = code + pc[1]; DISPATCH()
 #define HV_DIVK_I32 HV_DIVK(int32_t, false)
 #define HV_LDXH4 ELEM_INDEX(int16_t, 3) HV_SIMPLE(int32_t, ld<int32_t>(base + pc[2] + i * 4))
 #define HV_COV taken[pc[1] >> 6] |= uint64_t(1) << (pc[1] & 63); [[maybe_unused]] int v = 0;
-#define HV_JUMP_IF(c) if (c) { pc = code + pc[1]; DISPATCH(); } [[maybe_unused]] int v = 0;
+#define HV_JUMP_IF(c) if (c) TAKE(1); [[maybe_unused]] int v = 0;
 #define HV_JMPF HV_JUMP_IF(!ld<uint8_t>(base + pc[2]))
 #define HV_JGE_I32 HV_JUMP_IF(R(int32_t, 2) >= R(int32_t, 3))
 #define HV_JNLT_F32 HV_JUMP_IF(!(R(float, 2) < R(float, 3)))
@@ -804,8 +851,8 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) { pc = code + pc[1]; DISPATCH()
 #define MV_MUL_I32(K, X, OUT) MV_ARITH(int32_t, wmul, K, X, OUT)
 #define MV_MUL_F32(K, X, OUT) MV_ARITH(float, fmul, K, X, OUT)
 #define MV_ADD_F32(K, X, OUT) MV_ARITH(float, fadd, K, X, OUT)
-#define TV_JGE_I32(K, END, X) if (jge<int32_t>(OPND_##K(int32_t, X))) { pc = code + pc[1]; DISPATCH(); } END(3);
-#define TV_JNLT_F32(K, END, X) if (jnlt(OPND_##K(float, X))) { pc = code + pc[1]; DISPATCH(); } END(3);
+#define TV_JGE_I32(K, END, X) if (jge<int32_t>(OPND_##K(int32_t, X))) TAKE(1); END(3);
+#define TV_JNLT_F32(K, END, X) if (jnlt(OPND_##K(float, X))) TAKE(1); END(3);
 #define DIVK_OF(T, IS_MOD, X) \
   (divk<T, IS_MOD>(static_cast<T>(X), static_cast<uint64_t>(pc[3]) | (static_cast<uint64_t>(pc[4]) << 32), static_cast<int32_t>(pc[5])))
 #define TV_MODK_I32(K, END, X) W(int32_t, 1, DIVK_OF(int32_t, true, X)); END(5);
@@ -880,6 +927,7 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) { pc = code + pc[1]; DISPATCH()
 #undef W
 #undef PTR
 #undef BACKJUMP
+#undef TAKE
 }
 #pragma GCC diagnostic pop
 

@@ -24,7 +24,7 @@ struct Prog : vmtest::VmRun {
 };
 
 // Both tiers, scan by scan: same result, trap, memory, coverage.
-void same_in_both_tiers(const std::string& src, int scans) {
+void same_in_both_tiers(const std::string& src, int scans, uint64_t budget = 0) {
   auto b = build_sources({{"fast.st", src}}, CompileOptions{});
   ASSERT_TRUE(b->ok()) << b->diags.render_all();
   std::string err;
@@ -33,6 +33,10 @@ void same_in_both_tiers(const std::string& src, int scans) {
   EXPECT_EQ(native->interpreted(), 0u);
   Machine a(*b->app), n(*b->app);
   n.set_native(native.get());
+  if (budget != 0) {
+    a.set_budget(budget);
+    n.set_budget(budget);
+  }
   const auto& inst = b->app->programs.at(0);
   for (int s = 0; s < scans; ++s) {
     a.clear_taken();
@@ -355,6 +359,170 @@ TEST(VmFastPaths, IntIndexedReadsBehaveTheSameInTheNativeTier) {
   src.replace(src.find("v := a[bad];"), 12, "bad := (bad + 1) MOD 10; v := a[bad];");
   same_in_both_tiers(src, 12);
 }
+
+// ------------------------------------------------------------------ rank-2 arrays, whole elements
+
+// Two variable indices into a frame array (of scalars or structures, of rank 2 or with the
+// other indices constant) are one instruction; each index is checked in turn, the first one
+// first, with the message the ELEM chain gave. A whole structure element moves as a block.
+const char* kRank2 = R"(TYPE Cell : STRUCT v : DINT; f : INT; on : BOOL; END_STRUCT; END_TYPE
+PROGRAM P
+VAR m : ARRAY [1..3, -1..2] OF DINT; g : ARRAY [0..1, 0..2] OF Cell;
+    cube : ARRAY [0..1, 0..2, 0..3] OF INT; row : ARRAY [0..3] OF Cell;
+    i, j, k : DINT; s : DINT; t : Cell; bi : DINT := 1; bj : DINT := -1; x : DINT; END_VAR
+FOR i := 1 TO 3 DO FOR j := -1 TO 2 DO m[i, j] := i * 10 + j; END_FOR; END_FOR;
+FOR i := 0 TO 1 DO FOR j := 0 TO 2 DO g[i, j].v := i * 3 + j; g[i, j].f := INT#7; g[i, j].on := j = 1; END_FOR; END_FOR;
+FOR i := 0 TO 1 DO FOR j := 0 TO 3 DO cube[i, 1, j] := DINT_TO_INT(i * 4 + j); END_FOR; END_FOR;
+s := 0;
+FOR i := 1 TO 3 DO FOR j := -1 TO 2 DO s := s + m[i, j]; END_FOR; END_FOR;
+FOR k := 0 TO 3 DO row[k].v := k * 100; row[k].f := DINT_TO_INT(k); END_FOR;
+i := 2; t := row[i];              (* a whole element out *)
+i := 0; j := 3; row[i] := row[j]; (* element to element *)
+t.v := t.v + 1;
+i := 1; row[i] := t;              (* a whole element in *)
+FOR i := 0 TO 1 DO FOR j := 0 TO 2 DO IF g[i, j].on THEN s := s + g[i, j].v * 1000; END_IF; END_FOR; END_FOR;
+s := s + INT_TO_DINT(cube[1, 1, 3]) * 100000 + INT_TO_DINT(g[1, 2].f);
+x := m[bi, bj];                   (* traps when bi or bj is outside its bounds *)
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, RankTwoAccessIsOneInstructionAndChecksEachIndex) {
+  Prog p(kRank2);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_NE(std::string::npos, dis.find("LDXX4")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("STXX4")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("LDXX1")) << dis;   // g[i, j].on
+  EXPECT_NE(std::string::npos, dis.find("STXX2")) << dis;   // cube[i, 1, j]
+  EXPECT_NE(std::string::npos, dis.find("LDXB")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("STXB")) << dis;
+  EXPECT_EQ(std::string::npos, dis.find("ELEM")) << dis;
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  // m: sum of i*10+j over i 1..3, j -1..2 = 4*60 + 3*2; g: (1 + 4) * 1000; cube[1,1,3] = 7.
+  EXPECT_EQ(246 + 5000 + 700000 + 7, p.get("P.s"));
+  EXPECT_EQ(9, p.get("P.x"));
+  EXPECT_EQ(300, p.get("P.row[0].v"));
+  EXPECT_EQ(3, p.get("P.row[0].f"));
+  EXPECT_EQ(201, p.get("P.row[1].v"));
+  EXPECT_EQ(2, p.get("P.row[1].f"));
+  EXPECT_EQ(200, p.get("P.t.v") - 1);
+  p.set("P.bi", 4);
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ(TrapKind::IndexOutOfRange, p.m->trap().kind);
+  EXPECT_EQ("index 4 outside 1..3", p.m->trap().message);
+  EXPECT_EQ(18u, p.m->trap().loc.line);
+  p.set("P.bi", 3);
+  p.set("P.bj", 3);
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ("index 3 outside -1..2", p.m->trap().message);
+  p.set("P.bi", 0);  // both outside: the first index is reported
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ("index 0 outside 1..3", p.m->trap().message);
+}
+
+TEST(VmFastPaths, RankTwoAccessBehavesTheSameInTheNativeTier) {
+  std::string src = kRank2;
+  // bi and bj walk through and past their bounds: both tiers trap alike, on either index.
+  src.replace(src.find("x := m[bi, bj];"), 15, "bi := (bi + 1) MOD 5; bj := (bj + 2) MOD 5 - 1; x := m[bi, bj];");
+  same_in_both_tiers(src, 12);
+}
+
+// ------------------------------------------------------------------ loops tested at the bottom
+
+// WHILE and REPEAT end with one conditional jump back, which counts against the watchdog
+// as JMPB did; CONTINUE goes to the test, EXIT past it; coverage marks the body once per
+// entry. An endless loop still traps in both tiers.
+const char* kLoops = R"(PROGRAM P
+VAR n, w, r, c, e, z : DINT; spin : BOOL; END_VAR
+z := 0;
+WHILE spin DO z := z + 1; END_WHILE;             (* endless when spin *)
+n := n + 1;
+w := 0;
+WHILE w < n DO w := w + 1; END_WHILE;            (* n passes *)
+r := 0;
+REPEAT r := r + 2; UNTIL r >= n END_REPEAT;      (* at least one pass *)
+c := 0;
+WHILE c < 10 DO
+  c := c + 1;
+  IF c MOD 2 = 0 THEN CONTINUE; END_IF;
+  IF c = 7 THEN EXIT; END_IF;
+  e := e + c;
+END_WHILE;
+WHILE z > 0 DO z := z - 1; END_WHILE;            (* never runs here *)
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, LoopsTestAtTheBottomAndStillCountAgainstTheWatchdog) {
+  Prog p(kLoops);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_EQ(std::string::npos, dis.find("JMPB")) << dis;
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(1, p.get("P.w"));
+  EXPECT_EQ(2, p.get("P.r"));
+  EXPECT_EQ(7, p.get("P.c"));
+  EXPECT_EQ(1 + 3 + 5, p.get("P.e"));
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(2, p.get("P.w"));
+  EXPECT_EQ(2, p.get("P.r"));
+  p.m->set_budget(1000);
+  p.set("P.spin", 1);
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ(TrapKind::Watchdog, p.m->trap().kind);
+  EXPECT_EQ(4u, p.m->trap().loc.line);
+  EXPECT_EQ(1001, p.get("P.z"));  // 1000 jumps back allowed: the body ran 1001 times
+}
+
+TEST(VmFastPaths, LoopsTestedAtTheBottomBehaveTheSameInTheNativeTier) {
+  std::string src = kLoops;
+  // spin on every fifth scan: both tiers stop on the watchdog alike.
+  src.replace(src.find("n := n + 1;"), 11, "n := n + 1; spin := n MOD 5 = 0;");
+  same_in_both_tiers(src, 11, 5000);
+}
+
+// ------------------------------------------------------------------ tests of bits
+
+// `(x AND m) <> 0` and `(x AND m) = 0` as a condition are one jump on x and m, in every
+// width, also as a loop's test at the bottom; a comparison with anything but zero is not.
+const char* kBits = R"(PROGRAM P
+VAR b : BYTE := 16#A5; w : WORD := 16#8001; d : DWORD; l : LWORD := 16#8000000000000000;
+    n, odd, hi, ones, other : DINT; k : DINT; END_VAR
+n := n + 1;
+d := DINT_TO_DWORD(n * 7919);
+odd := 0; hi := 0; ones := 0; other := 0;
+FOR k := 0 TO 7 DO
+  IF (SHR(b, k) AND 16#1) <> 0 THEN odd := odd + 1; END_IF;
+END_FOR;
+IF (w AND 16#8000) = 16#0 THEN hi := 1; END_IF;
+IF 0 <> (l AND 16#8000000000000000) THEN hi := hi + 10; END_IF;
+WHILE (d AND 16#FFFF) <> 0 DO d := d AND DINT_TO_DWORD(DWORD_TO_DINT(d) - 1); ones := ones + 1; END_WHILE;
+IF (w AND 16#3) = 16#1 THEN other := 1; END_IF;
+b := ROL(b, 1);
+w := w XOR 16#8000;
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, TestsOfBitsAreOneJump) {
+  Prog p(kBits);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_NE(std::string::npos, dis.find("JTZ_U8")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("JTNZ_U16")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("JTZ_U64")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("JTZ_U32")) << dis;   // the WHILE's entry test
+  EXPECT_NE(std::string::npos, dis.find("JTNZ_U32")) << dis;  // and its test at the bottom
+  EXPECT_NE(std::string::npos, dis.find("JNE_U16")) << dis;   // (w AND 3) = 1: an ordinary comparison
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(4, p.get("P.odd"));  // 16#A5 has four bits set
+  EXPECT_EQ(10, p.get("P.hi"));  // w has bit 15: no 1; l has bit 63: 10
+  EXPECT_EQ(__builtin_popcount(7919u & 0xFFFFu), p.get("P.ones"));
+  EXPECT_EQ(1, p.get("P.other"));
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(11, p.get("P.hi"));  // w without bit 15 now
+  EXPECT_EQ(__builtin_popcount((2u * 7919u) & 0xFFFFu), p.get("P.ones"));
+}
+
+TEST(VmFastPaths, TestsOfBitsBehaveTheSameInTheNativeTier) { same_in_both_tiers(kBits, 20); }
 
 }  // namespace
 }  // namespace plcfi::st
