@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -1623,12 +1623,19 @@ int run_jobs(const std::vector<Job>& jobs, unsigned parallel, bool progress, con
   return failed;
 }
 
-unsigned default_jobs(const NativeOptions& o) {
+// How many compilers run at once: the options', else $PLCFI_JOBS, else one per core.
+// 0 with *err set: $PLCFI_JOBS is not a count.
+unsigned compile_jobs(const NativeOptions& o, std::string* err) {
   if (o.jobs) return o.jobs;
   if (const char* j = std::getenv("PLCFI_JOBS"); j && *j) {
     char* end = nullptr;
+    errno = 0;
     long n = std::strtol(j, &end, 10);
-    if (*end == 0 && n > 0 && n <= 256) return static_cast<unsigned>(n);
+    if (errno != 0 || *end != 0 || n < 1 || n > 256) {
+      *err = fmt::format("native tier: PLCFI_JOBS is '{}': give the number of compilers to run at once, from 1 to 256", j);
+      return 0;
+    }
+    return static_cast<unsigned>(n);
   }
   return std::max(1u, std::thread::hardware_concurrency());
 }
@@ -1722,6 +1729,8 @@ NativeCode::~NativeCode() {
 }
 
 std::unique_ptr<NativeCode> NativeCode::build(const Application& app, const NativeOptions& o, std::string* err) {
+  const unsigned n_jobs = compile_jobs(o, err);
+  if (n_jobs == 0) return nullptr;
   NativeProgram prog = native_program(app, o.split_bytes, o.chunk_instructions);
   std::string compiler = !o.compiler.empty() ? o.compiler : (std::getenv("PLCFI_CXX") ? std::getenv("PLCFI_CXX") : "c++");
   std::string optimize = prog.split ? o.optimize_split : o.optimize;
@@ -1789,7 +1798,7 @@ std::unique_ptr<NativeCode> NativeCode::build(const Application& app, const Nati
     unit_of = std::move(sorted_units);
     nc->units_compiled_ = jobs.size();
     int rc = 0;
-    int failed = run_jobs(jobs, default_jobs(o), o.progress, prog.split ? "units" : "the program", &rc);
+    int failed = run_jobs(jobs, n_jobs, o.progress, prog.split ? "units" : "the program", &rc);
     if (failed >= 0) {
       *err = rc < 0 ? fmt::format("native tier: cannot run the C++ compiler '{}' (set PLCFI_CXX, or install g++)", compiler)
                     : fmt::format("native tier: '{}' failed on the generated code (exit {}), kept in {}{}", compiler, rc,
