@@ -366,6 +366,7 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
   uint8_t* const mem = mem_.data();
   const uint64_t msize = mem_.size();
   const uint32_t* const code = exec_.data();
+  const uint32_t* const orig = app_->code.data();  // the opcodes, for COVER
   const uint32_t* pc = code + entry;
   const uint32_t* const vtable = app_->vtable.data();
   const uint32_t n_types = app_->n_types;
@@ -395,12 +396,28 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
   // REPEAT test at the bottom): it counts against the watchdog, as JMPB does.
 #define TAKE(k)                                  \
   do {                                           \
-    const uint32_t* const to_ = code + pc[k];    \
+    const uint32_t* to_ = code + pc[k];          \
     if (to_ <= pc) {                             \
       BACKJUMP();                                \
     }                                            \
+    COVER(to_);                                  \
     pc = to_;                                    \
     DISPATCH();                                  \
+  } while (0)
+  // A branch marks the coverage of the arm it enters: a COV where a conditional jump or a
+  // CASE table leads (taken or not) is done there and skipped, which spares every arm a
+  // dispatch. The same bit is set as by the COV itself.
+#define COVER(p)                                                  \
+  if (orig[(p) - code] == static_cast<uint32_t>(Op::COV)) {       \
+    taken[(p)[1] >> 6] |= uint64_t(1) << ((p)[1] & 63);           \
+    (p) += 2;                                                     \
+  }
+  // The fall-through of a conditional jump of n operands.
+#define FALL(n)  \
+  do {           \
+    pc += 1 + n; \
+    COVER(pc);   \
+    DISPATCH();  \
   } while (0)
 
   DISPATCH();
@@ -429,10 +446,10 @@ L_JMPB:
   DISPATCH();
 L_JMPF:
   if (!ld<uint8_t>(base + pc[2])) TAKE(1);
-  NEXT(2);
+  FALL(2);
 L_JMPT:
   if (ld<uint8_t>(base + pc[2])) TAKE(1);
-  NEXT(2);
+  FALL(2);
 L_CALL:
   if (sp == kMaxDepth) return fail(TrapKind::CallDepth, pc, "call depth exceeded (recursion?)");
   stack_[sp++] = {pc + 3, base, mtop};
@@ -486,6 +503,7 @@ L_JTAB: {
   int64_t i = static_cast<int64_t>(ld<int32_t>(base + pc[1])) - static_cast<int32_t>(pc[2]);
   if (i >= 0 && i < static_cast<int64_t>(pc[3])) pc = code + pc[5 + i];
   else pc = code + pc[4];
+  COVER(pc);
   DISPATCH();
 }
 L_COV:
@@ -625,10 +643,10 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
   L_LE_##TN: W(uint8_t, 1, R(C, 2) <= R(C, 3)); NEXT(3);                                \
   L_GT_##TN: W(uint8_t, 1, R(C, 2) > R(C, 3)); NEXT(3);                                 \
   L_GE_##TN: W(uint8_t, 1, R(C, 2) >= R(C, 3)); NEXT(3);                                \
-  L_JLT_##TN: if (R(C, 2) < R(C, 3)) TAKE(1); NEXT(3);        \
-  L_JGE_##TN: if (R(C, 2) >= R(C, 3)) TAKE(1); NEXT(3);       \
-  L_JEQ_##TN: if (R(C, 2) == R(C, 3)) TAKE(1); NEXT(3);       \
-  L_JNE_##TN: if (R(C, 2) != R(C, 3)) TAKE(1); NEXT(3);       \
+  L_JLT_##TN: if (R(C, 2) < R(C, 3)) TAKE(1); FALL(3);        \
+  L_JGE_##TN: if (R(C, 2) >= R(C, 3)) TAKE(1); FALL(3);       \
+  L_JEQ_##TN: if (R(C, 2) == R(C, 3)) TAKE(1); FALL(3);       \
+  L_JNE_##TN: if (R(C, 2) != R(C, 3)) TAKE(1); FALL(3);       \
   L_MIN_##TN: { C x = R(C, 2), y = R(C, 3); W(C, 1, y < x ? y : x); NEXT(3); }          \
   L_MAX_##TN: { C x = R(C, 2), y = R(C, 3); W(C, 1, x < y ? y : x); NEXT(3); }          \
   L_ABS_##TN: W(C, 1, wabs<C>(R(C, 2))); NEXT(2);                                       \
@@ -658,8 +676,8 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
     NEXT(3);                                                                             \
   }                                                                                      \
   L_AND_##TN: W(C, 1, static_cast<C>(R(C, 2) & R(C, 3))); NEXT(3);                       \
-  L_JTZ_##TN: if ((R(C, 2) & R(C, 3)) == 0) TAKE(1); NEXT(3);                              \
-  L_JTNZ_##TN: if ((R(C, 2) & R(C, 3)) != 0) TAKE(1); NEXT(3);                             \
+  L_JTZ_##TN: if ((R(C, 2) & R(C, 3)) == 0) TAKE(1); FALL(3);                              \
+  L_JTNZ_##TN: if ((R(C, 2) & R(C, 3)) != 0) TAKE(1); FALL(3);                             \
   L_OR_##TN: W(C, 1, static_cast<C>(R(C, 2) | R(C, 3))); NEXT(3);                        \
   L_XOR_##TN: W(C, 1, static_cast<C>(R(C, 2) ^ R(C, 3))); NEXT(3);                       \
   L_NOT_##TN: W(C, 1, static_cast<C>(~R(C, 2))); NEXT(2);                                \
@@ -769,10 +787,10 @@ L_STXB: {
 #undef ELEM_INDEX2
 
 // Float compare-and-jump, taken when the comparison fails (NaN included).
-L_JNLT_F32: if (!(R(float, 2) < R(float, 3))) TAKE(1); NEXT(3);
-L_JNGE_F32: if (!(R(float, 2) >= R(float, 3))) TAKE(1); NEXT(3);
-L_JNLT_F64: if (!(R(double, 2) < R(double, 3))) TAKE(1); NEXT(3);
-L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); NEXT(3);
+L_JNLT_F32: if (!(R(float, 2) < R(float, 3))) TAKE(1); FALL(3);
+L_JNGE_F32: if (!(R(float, 2) >= R(float, 3))) TAKE(1); FALL(3);
+L_JNLT_F64: if (!(R(double, 2) < R(double, 3))) TAKE(1); FALL(3);
+L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); FALL(3);
 
 #define DIVK_IMPL(NAME, T, IS_MOD)                                                      \
   L_##NAME: {                                                                           \
@@ -928,6 +946,8 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); NEXT(3);
 #undef PTR
 #undef BACKJUMP
 #undef TAKE
+#undef COVER
+#undef FALL
 }
 #pragma GCC diagnostic pop
 
