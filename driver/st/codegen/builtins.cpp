@@ -700,11 +700,15 @@ std::optional<Val> Compiler::emit_shift(const StdFunc& f, const CallExpr& c) {
     t = v.type;
   }
   Slot a = to_slot(v, t, args[0]->loc);
-  Slot b = n.is_const ? konst(elem(TypeKind::ULInt), n.c, args[1]->loc) : convert(n.slot, nt, elem(TypeKind::ULInt));
-  Op base = f.shift == Shift::Shl   ? Op::SHL_I8
-            : f.shift == Shift::Shr ? Op::SHR_I8
-            : f.shift == Shift::Rol ? Op::ROL_I8
-                                    : Op::ROR_I8;
+  // A DINT count (a loop counter, most often) is read as it is, without a ULINT copy.
+  const bool dint_count = !n.is_const && nt->storage() == Storage::I32;
+  Slot b = n.is_const ? konst(elem(TypeKind::ULInt), n.c, args[1]->loc)
+           : dint_count ? n.slot
+                        : convert(n.slot, nt, elem(TypeKind::ULInt));
+  Op base = f.shift == Shift::Shl   ? (dint_count ? Op::SHLD_I8 : Op::SHL_I8)
+            : f.shift == Shift::Shr ? (dint_count ? Op::SHRD_I8 : Op::SHR_I8)
+            : f.shift == Shift::Rol ? (dint_count ? Op::ROLD_I8 : Op::ROL_I8)
+                                    : (dint_count ? Op::RORD_I8 : Op::ROR_I8);
   Slot d = temp_for(t);
   emit(int_op(base, t->storage()), {d, a, b});
   def(d);

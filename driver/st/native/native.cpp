@@ -404,7 +404,8 @@ class Translator {
         {"SHL", TypedFamily::kNever},    {"SHR", TypedFamily::kNever},    {"ROL", TypedFamily::kNever},
         {"ROR", TypedFamily::kNever},    {"CHK", TypedFamily::kAlways},   {"LOOPUP", TypedFamily::kAlways},
         {"LOOPDN", TypedFamily::kAlways}, {"ROUND", TypedFamily::kNever}, {"TRUNC", TypedFamily::kNever},
-        {"JTZ", TypedFamily::kNever},    {"JTNZ", TypedFamily::kNever},
+        {"JTZ", TypedFamily::kNever},    {"JTNZ", TypedFamily::kNever},   {"SHLD", TypedFamily::kNever},
+        {"SHRD", TypedFamily::kNever},   {"ROLD", TypedFamily::kNever},   {"RORD", TypedFamily::kNever},
     };
     size_t us = op_name.find('_');
     if (us == std::string_view::npos) return nullptr;
@@ -1006,6 +1007,10 @@ class Translator {
       std::string f(fam);
       std::transform(f.begin(), f.end(), f.begin(), [](char ch) { return static_cast<char>(ch - 'A' + 'a'); });
       s = W(C, 1, fmt::format("({}<{}>({}, {}))", f, C, R(C, 2), R("uint64_t", 3)));
+    } else if (fam == "SHLD" || fam == "SHRD" || fam == "ROLD" || fam == "RORD") {
+      std::string f(fam.substr(0, 3));
+      std::transform(f.begin(), f.end(), f.begin(), [](char ch) { return static_cast<char>(ch - 'A' + 'a'); });
+      s = W(C, 1, fmt::format("({}<{}>({}, dint_count({})))", f, C, R(C, 2), R("int32_t", 3)));
     } else if (fam == "CHK")
       s = fmt::format("{0} v = {1}, lo = {2}, hi = {3}; if (v < lo || v > hi) TRAP({4}, {5}, v, lo, hi);", C, R(C, 1),
                       R(C, 2), R(C, 3), w[4] == 1 ? 2 : 3, P(pc));

@@ -95,6 +95,9 @@ inline T shr(T v, uint64_t n) {
   if (n >= sizeof(T) * 8) return T(0);
   return static_cast<T>(static_cast<U>(static_cast<U>(v) >> n));
 }
+// A DINT shift count as SHL/SHR/ROL/ROR see it after the count's conversion to ULINT
+// (sign-extended: a negative count is a huge one).
+inline uint64_t dint_count(int32_t n) { return static_cast<uint64_t>(static_cast<int64_t>(n)); }
 template <class T>
 inline T rol(T v, uint64_t n) {
   constexpr uint64_t w = sizeof(T) * 8;

@@ -685,6 +685,10 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
   L_SHR_##TN: W(C, 1, shr<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
   L_ROL_##TN: W(C, 1, rol<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
   L_ROR_##TN: W(C, 1, ror<C>(R(C, 2), R(uint64_t, 3))); NEXT(3);                         \
+  L_SHLD_##TN: W(C, 1, shl<C>(R(C, 2), dint_count(R(int32_t, 3)))); NEXT(3);             \
+  L_SHRD_##TN: W(C, 1, shr<C>(R(C, 2), dint_count(R(int32_t, 3)))); NEXT(3);             \
+  L_ROLD_##TN: W(C, 1, rol<C>(R(C, 2), dint_count(R(int32_t, 3)))); NEXT(3);             \
+  L_RORD_##TN: W(C, 1, ror<C>(R(C, 2), dint_count(R(int32_t, 3)))); NEXT(3);             \
   L_CHK_##TN: {                                                                          \
     C v = R(C, 1), lo = R(C, 2), hi = R(C, 3);                                           \
     if ((v < lo || v > hi) && pc[4] == 1)                                                \

@@ -524,5 +524,50 @@ TEST(VmFastPaths, TestsOfBitsAreOneJump) {
 
 TEST(VmFastPaths, TestsOfBitsBehaveTheSameInTheNativeTier) { same_in_both_tiers(kBits, 20); }
 
+// ------------------------------------------------------------------ shift counts
+
+// A DINT count is read as it is (SHLD...); the result is SHL's after the count's conversion
+// to ULINT: a negative count or one of the width or more shifts everything out, and a
+// rotation takes the count modulo the width (a negative one, sign-extended, too).
+const char* kShifts = R"(PROGRAM P
+VAR b : BYTE := 16#81; w : WORD := 16#8001; d : DWORD := 16#80000001; l : LWORD := 16#8000000000000001;
+    n : DINT; r1, r2, r3, r4 : DWORD; q1, q2 : BYTE; s1, s2 : WORD; z1, z2 : LWORD; i : INT := 3; ri : WORD; END_VAR
+r1 := SHL(d, n); r2 := SHR(d, n); r3 := ROL(d, n); r4 := ROR(d, n);
+q1 := ROL(b, n); q2 := SHR(b, n);
+s1 := ROR(w, n); s2 := SHL(w, n);
+z1 := ROL(l, n); z2 := SHR(l, n);
+ri := ROL(w, i);
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, DintShiftCountsAreReadAsTheyAre) {
+  Prog p(kShifts);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  for (const char* op : {"SHLD_U32", "SHRD_U32", "ROLD_U32", "RORD_U32", "ROLD_U8", "RORD_U16", "SHRD_U64"})
+    EXPECT_NE(std::string::npos, dis.find(op)) << op << "\n" << dis;
+  EXPECT_NE(std::string::npos, dis.find("ROL_U16")) << dis;  // an INT count keeps its conversion
+  auto rol32 = [](uint32_t v, int k) { k &= 31; return k ? (v << k) | (v >> (32 - k)) : v; };
+  for (int n : {0, 1, 5, 31, 32, 33, 40, -1, -33}) {
+    p.set("P.n", n);
+    ASSERT_TRUE(p.scan()) << p.m->trap().message;
+    uint32_t d = 0x80000001u;
+    bool out = n < 0 || n >= 32;
+    EXPECT_EQ(out ? 0u : static_cast<uint32_t>(uint64_t{d} << n), static_cast<uint32_t>(p.get("P.r1"))) << n;
+    EXPECT_EQ(out ? 0u : d >> n, static_cast<uint32_t>(p.get("P.r2"))) << n;
+    // A negative count is 2^64 + n as ULINT: modulo 32 that is n modulo 32 (32 divides 2^64).
+    int k = ((n % 32) + 32) % 32;
+    EXPECT_EQ(rol32(d, k), static_cast<uint32_t>(p.get("P.r3"))) << n;
+    EXPECT_EQ(rol32(d, (32 - k) % 32), static_cast<uint32_t>(p.get("P.r4"))) << n;
+  }
+  EXPECT_EQ(((0x8001 << 3) & 0xFFFF) | (0x8001 >> 13), p.get("P.ri"));
+}
+
+TEST(VmFastPaths, DintShiftCountsBehaveTheSameInTheNativeTier) {
+  std::string src = kShifts;
+  src.replace(src.find("r1 := SHL"), 0, "n := n + 7; IF n > 70 THEN n := -70; END_IF;\n");
+  same_in_both_tiers(src, 25);
+}
+
 }  // namespace
 }  // namespace plcfi::st
