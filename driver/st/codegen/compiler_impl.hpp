@@ -318,6 +318,7 @@ class Compiler {
   // (Defined in stmt.cpp.)
   void branch_on(const Val& c, SourceLoc loc, Label target, bool when_true);
   bool test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero);
+  std::pair<Arg, Arg> unemit(uint32_t at);
   Val bad() {
     Val v;
     v.ok = false;

@@ -35,6 +35,21 @@ struct ArmScope {
 };
 }  // namespace
 
+// Drops the code from `at` on (an instruction a peephole replaces) and returns the
+// operands it had at words at + 2 and at + 3, each with its slot kind.
+std::pair<Arg, Arg> Compiler::unemit(uint32_t at) {
+  auto& code = b_->code;
+  Arg x(code[at + 2]), y(at + 3 < code.size() ? Arg(code[at + 3]) : Arg(0u));
+  for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
+    if (it->first == at + 2) x = Arg(Slot{code[at + 2], it->second});
+    if (it->first == at + 3) y = Arg(Slot{code[at + 3], it->second});
+    if (it->first >= at) it = b_->slot_fix.erase(it);
+    else ++it;
+  }
+  code.resize(at);
+  return {x, y};
+}
+
 // A test of bits: "AND t, x, m; EQ/NE c, t, 0" compiled into a jump is one JTZ or JTNZ
 // on x and m, when the AND is the instruction right before the comparison, in the same
 // statement line and block, and defines a temporary only the comparison reads. `if_zero`:
@@ -64,14 +79,7 @@ bool Compiler::test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool 
   const bool t_first = code[cmp_at + 2] == t && kind_at(cmp_at + 2) == SK::Temp && zero(cmp_at + 3);
   const bool t_second = code[cmp_at + 3] == t && kind_at(cmp_at + 3) == SK::Temp && zero(cmp_at + 2);
   if (!t_first && !t_second) return false;
-  Arg x(code[and_at + 2]), y(code[and_at + 3]);
-  for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
-    if (it->first == and_at + 2) x = Arg(Slot{code[and_at + 2], it->second});
-    if (it->first == and_at + 3) y = Arg(Slot{code[and_at + 3], it->second});
-    if (it->first >= and_at) it = b_->slot_fix.erase(it);
-    else ++it;
-  }
-  code.resize(and_at);
+  auto [x, y] = unemit(and_at);
   emit(int_op(if_zero ? Op::JTZ_I8 : Op::JTNZ_I8, static_cast<Storage>(type_idx)), {Arg::target(target.id), x, y});
   b_->last_def_pos = UINT32_MAX;
   return true;
@@ -89,13 +97,7 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
   if (!c.is_const && b_->last_def_pos == at && b_->last_label_pos <= at && code[at] == static_cast<uint32_t>(Op::BNOT) &&
       b_->last_def.kind == cs.kind && b_->last_def.off == cs.off && cs.kind == SK::Temp) {
     // "BNOT t, x; JMPF target, t" -> "JMPT target, x".
-    Arg x(code[at + 2]);
-    for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
-      if (it->first == at + 2) x = Arg(Slot{code[at + 2], it->second});
-      if (it->first >= at) it = b_->slot_fix.erase(it);
-      else ++it;
-    }
-    code.resize(at);
+    Arg x = unemit(at).first;
     emit(when_true ? Op::JMPF : Op::JMPT, {Arg::target(target.id), x});
     b_->last_def_pos = UINT32_MAX;
     return;
@@ -138,14 +140,7 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
         }
         if (!is_float && (m.cmp == Op::EQ_I8 || m.cmp == Op::NE_I8) && test_bits(at, type_idx, target, m.cmp == Op::EQ_I8 ? when_true : !when_true))
           return;
-        Arg a(code[at + 2]), b2(code[at + 3]);
-        for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
-          if (it->first == at + 2) a = Arg(Slot{code[at + 2], it->second});
-          if (it->first == at + 3) b2 = Arg(Slot{code[at + 3], it->second});
-          if (it->first >= at) it = b_->slot_fix.erase(it);
-          else ++it;
-        }
-        code.resize(at);
+        auto [a, b2] = unemit(at);
         Op op_j = fj != Op::NOP ? fj : static_cast<Op>(static_cast<uint32_t>(j) + type_idx * stride);
         emit(op_j, {Arg::target(target.id), swap ? b2 : a, swap ? a : b2});
         b_->last_def_pos = UINT32_MAX;
