@@ -366,7 +366,6 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
   uint8_t* const mem = mem_.data();
   const uint64_t msize = mem_.size();
   const uint32_t* const code = exec_.data();
-  const uint32_t* const orig = app_->code.data();  // the opcodes, for COVER
   const uint32_t* pc = code + entry;
   const uint32_t* const vtable = app_->vtable.data();
   const uint32_t n_types = app_->n_types;
@@ -407,8 +406,10 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
   // A branch marks the coverage of the arm it enters: a COV where a conditional jump or a
   // CASE table leads (taken or not) is done there and skipped, which spares every arm a
   // dispatch. The same bit is set as by the COV itself.
-#define COVER(p)                                                  \
-  if (orig[(p) - code] == static_cast<uint32_t>(Op::COV)) {       \
+  // (A COV that heads a superinstruction is left to it.) The word is compared with the
+  // static table's, which keeps no further pointer live across the handlers.
+#define COVER(p)                                                                     \
+  if (*(p) == static_cast<uint32_t>(kOffsets[static_cast<uint32_t>(Op::COV)])) {     \
     taken[(p)[1] >> 6] |= uint64_t(1) << ((p)[1] & 63);           \
     (p) += 2;                                                     \
   }
