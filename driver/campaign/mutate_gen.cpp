@@ -97,13 +97,6 @@ const std::map<std::string, st::Op>& ops_by_name() {
 
 std::string op_name(st::Op op) { return st::op_info(op).name; }
 
-// Conditional jumps: JMPF/JMPT (a = target) and the compare-and-jump family.
-bool is_cond_jump(st::Op op) {
-  std::string n = op_name(op);
-  return n == "JMPF" || n == "JMPT" || n.rfind("JLT_", 0) == 0 || n.rfind("JGE_", 0) == 0 || n.rfind("JEQ_", 0) == 0 ||
-         n.rfind("JNE_", 0) == 0 || n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0 || n.rfind("JTZ_", 0) == 0 ||
-         n.rfind("JTNZ_", 0) == 0;
-}
 st::Op negated_jump(st::Op op) {
   std::string n = op_name(op);
   static const std::pair<const char*, const char*> swaps[] = {{"JMPF", "JMPT"}, {"JMPT", "JMPF"}, {"JLT_", "JGE_"},
@@ -423,7 +416,7 @@ class Generator {
           int32_t b = branch_of(p, k, &known, &cov);
           if (b < 0 || cov == 0) continue;
           const Insn& j = v[cov - 1];
-          if (!is_cond_jump(j.op) || j.pc + j.len != v[cov].pc || labels_.count(v[cov].pc)) continue;
+          if (!st::is_conditional_jump(j.op) || j.pc + j.len != v[cov].pc || labels_.count(v[cov].pc)) continue;
           auto& g = guards_[{p, cov - 1}];
           if (std::find(g.begin(), g.end(), name) == g.end()) g.push_back(name);
           for (uint32_t slot : condition_reads(p, cov - 1)) add_feeder(p, slot, &grew);

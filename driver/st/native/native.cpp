@@ -85,20 +85,15 @@ void jump_targets(const uint32_t* w, std::vector<uint32_t>* out) {
   auto op = static_cast<Op>(w[0]);
   switch (op) {
     case Op::JMP:
-    case Op::JMPB:
-    case Op::JMPF:
-    case Op::JMPT: out->push_back(w[1]); return;
+    case Op::JMPB: out->push_back(w[1]); return;
     case Op::JTAB:
       out->push_back(w[4]);
       for (uint32_t i = 0; i < w[3]; ++i) out->push_back(w[5 + i]);
       return;
     default: break;
   }
+  if (is_conditional_jump(op)) out->push_back(w[1]);
   std::string_view n = op_info(op).name;
-  if (n.size() > 4 && (n.substr(0, 4) == "JLT_" || n.substr(0, 4) == "JGE_" || n.substr(0, 4) == "JEQ_" || n.substr(0, 4) == "JNE_"))
-    out->push_back(w[1]);
-  if (n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0 || n.rfind("JTZ_", 0) == 0 || n.rfind("JTNZ_", 0) == 0)
-    out->push_back(w[1]);
   if (n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) out->push_back(w[4]);
 }
 
@@ -420,10 +415,7 @@ class Translator {
     auto op = static_cast<Op>(code_[pc]);
     std::string_view n = op_info(op).name;
     if (op == Op::JMPB || n.rfind("LOOPUP_", 0) == 0 || n.rfind("LOOPDN_", 0) == 0) return true;
-    bool conditional = op == Op::JMPF || op == Op::JMPT || n.rfind("JLT_", 0) == 0 || n.rfind("JGE_", 0) == 0 ||
-                       n.rfind("JEQ_", 0) == 0 || n.rfind("JNE_", 0) == 0 || n.rfind("JNLT_", 0) == 0 || n.rfind("JNGE_", 0) == 0 ||
-                       n.rfind("JTZ_", 0) == 0 || n.rfind("JTNZ_", 0) == 0;
-    return conditional && code_[pc + 1] <= pc;
+    return is_conditional_jump(op) && code_[pc + 1] <= pc;
   }
 
   void summarize() {

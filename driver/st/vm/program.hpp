@@ -32,6 +32,9 @@ struct OpInfo {
 const OpInfo& op_info(Op op);
 // Operand words that follow the opcode (JTAB adds its table).
 uint32_t op_length(const uint32_t* code);
+// A conditional jump whose first operand is its target: JMPF, JMPT and the
+// compare-and-jump and bit-test families (JLT_, JGE_, JEQ_, JNE_, JNLT_, JNGE_, JTZ_, JTNZ_).
+bool is_conditional_jump(Op op);
 
 // Where a variable lives.
 enum class Where : uint8_t {

@@ -54,6 +54,21 @@ constexpr OpInfo kOps[] = {
 
 const OpInfo& op_info(Op op) { return kOps[static_cast<uint32_t>(op)]; }
 
+bool is_conditional_jump(Op op) {
+  static const std::vector<bool> table = [] {
+    std::vector<bool> t(static_cast<size_t>(Op::Count_));
+    static constexpr std::string_view kFamilies[] = {"JLT_", "JGE_", "JEQ_", "JNE_", "JNLT_", "JNGE_", "JTZ_", "JTNZ_"};
+    for (size_t i = 0; i < t.size(); ++i) {
+      std::string_view n = kOps[i].name;
+      bool family = false;
+      for (std::string_view f : kFamilies) family = family || n.rfind(f, 0) == 0;
+      t[i] = family || n == "JMPF" || n == "JMPT";
+    }
+    return t;
+  }();
+  return table[static_cast<size_t>(op)];
+}
+
 uint32_t op_length(const uint32_t* code) {
   Op op = static_cast<Op>(code[0]);
   if (op == Op::JTAB) return 1 + 4 + code[3];
@@ -733,12 +748,13 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
 // Element access into frame arrays, bounds-checked: LDX/STX (elementary elements),
 // LDXS/STXS (a field of a structure element), each with a DINT index or, as the H
 // variants, an INT index (no DINT copy of a loop counter per access).
-#define ELEM_INDEX(IT, k)                                                                      \
-  int64_t i = static_cast<int64_t>(R(IT, k)) - static_cast<int32_t>(pc[k + 1]);                \
-  if (i < 0 || i >= static_cast<int64_t>(pc[k + 2]))                                           \
-    return fail(TrapKind::IndexOutOfRange, pc,                                                 \
+#define ELEM_INDEX_AS(v, IT, k)                                                                 \
+  int64_t v = static_cast<int64_t>(R(IT, k)) - static_cast<int32_t>(pc[k + 1]);                 \
+  if (v < 0 || v >= static_cast<int64_t>(pc[k + 2]))                                            \
+    return fail(TrapKind::IndexOutOfRange, pc,                                                  \
                 fmt::format("index {} outside {}..{}", R(IT, k), static_cast<int32_t>(pc[k + 1]), \
                             static_cast<int64_t>(static_cast<int32_t>(pc[k + 1])) + pc[k + 2] - 1));
+#define ELEM_INDEX(IT, k) ELEM_INDEX_AS(i, IT, k)
 #define ELEM_IMPL(H, IT, N, T)                                                                 \
   L_LDX##H##N: { ELEM_INDEX(IT, 3) W(T, 1, ld<T>(base + pc[2] + i * N)); NEXT(5); }            \
   L_STX##H##N: { ELEM_INDEX(IT, 2) st<T>(base + pc[1] + i * N, R(T, 5)); NEXT(5); }            \
@@ -756,12 +772,7 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
 
 // Rank-2 frame arrays (LDXX/STXX): both indices checked, the first one first, as the
 // ELEM chain they replace checks them.
-#define ELEM_INDEX2(v, k)                                                                       \
-  int64_t v = static_cast<int64_t>(R(int32_t, k)) - static_cast<int32_t>(pc[k + 1]);            \
-  if (v < 0 || v >= static_cast<int64_t>(pc[k + 2]))                                            \
-    return fail(TrapKind::IndexOutOfRange, pc,                                                  \
-                fmt::format("index {} outside {}..{}", R(int32_t, k), static_cast<int32_t>(pc[k + 1]), \
-                            static_cast<int64_t>(static_cast<int32_t>(pc[k + 1])) + pc[k + 2] - 1));
+#define ELEM_INDEX2(v, k) ELEM_INDEX_AS(v, int32_t, k)
 #define ELEM2_IMPL(N, T)                                                                        \
   L_LDXX##N: {                                                                                  \
     ELEM_INDEX2(i0, 3) ELEM_INDEX2(i1, 7)                                                       \
@@ -874,8 +885,9 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); FALL(3);
 #define MV_MUL_I32(K, X, OUT) MV_ARITH(int32_t, wmul, K, X, OUT)
 #define MV_MUL_F32(K, X, OUT) MV_ARITH(float, fmul, K, X, OUT)
 #define MV_ADD_F32(K, X, OUT) MV_ARITH(float, fadd, K, X, OUT)
-#define TV_JGE_I32(K, END, X) if (jge<int32_t>(OPND_##K(int32_t, X))) TAKE(1); END(3);
-#define TV_JNLT_F32(K, END, X) if (jnlt(OPND_##K(float, X))) TAKE(1); END(3);
+// A jump ends the handler: its fall-through marks the arm it enters, as FALL does (END unused).
+#define TV_JGE_I32(K, END, X) if (jge<int32_t>(OPND_##K(int32_t, X))) TAKE(1); FALL(3);
+#define TV_JNLT_F32(K, END, X) if (jnlt(OPND_##K(float, X))) TAKE(1); FALL(3);
 #define DIVK_OF(T, IS_MOD, X) \
   (divk<T, IS_MOD>(static_cast<T>(X), static_cast<uint64_t>(pc[3]) | (static_cast<uint64_t>(pc[4]) << 32), static_cast<int32_t>(pc[5])))
 #define TV_MODK_I32(K, END, X) W(int32_t, 1, DIVK_OF(int32_t, true, X)); END(5);
@@ -941,6 +953,7 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); FALL(3);
 #undef FUSED_P3
 #undef THEN_LOOPUP_I16
 #undef ELEM_INDEX
+#undef ELEM_INDEX_AS
 
 #undef LABEL_OFFSET
 #undef PLCFI_FUSED
