@@ -16,6 +16,19 @@ namespace plcfi::st::detail {
 // could change variables or take the method stack's top. Conservative: only literals,
 // variables, fields of a named structure or instance, and operators over them are known
 // to run none. Iterative, so that a long operator chain costs no stack.
+namespace {
+// Standard functions whose result depends on their inputs alone and that write nothing.
+bool pure_std_family(StdFamily f) {
+  switch (f) {
+    case StdFamily::Math: case StdFamily::Expt: case StdFamily::Abs: case StdFamily::Extremum: case StdFamily::Sel:
+    case StdFamily::Mux: case StdFamily::Operator: case StdFamily::ConcatDateTod: case StdFamily::Move: case StdFamily::Shift:
+    case StdFamily::String: case StdFamily::Concat: case StdFamily::Replace: case StdFamily::SizeOf: case StdFamily::Bound:
+      return true;
+    default: return false;
+  }
+}
+}  // namespace
+
 bool Compiler::may_call(const Expr& root) const {
   std::vector<const Expr*> todo{&root};
   while (!todo.empty()) {
@@ -52,6 +65,24 @@ bool Compiler::may_call(const Expr& root) const {
         const auto& ix = static_cast<const IndexExpr&>(*e);
         todo.push_back(ix.base.get());
         for (const auto& i : ix.indices) todo.push_back(i.get());
+        break;
+      }
+      case ExprKind::Call: {
+        // A standard function that computes a value from its inputs (SHL, MIN, LEN,
+        // INT_TO_DINT, ...) changes no variable: it is no call here.
+        const auto& c = static_cast<const CallExpr&>(*e);
+        if (c.callee->kind != ExprKind::Name) return true;
+        const std::string key = canon(static_cast<const NameExpr&>(*c.callee).name.text);
+        if (lookup(key) || pous_.count(key)) return true;
+        if (const StdFunc* f = find_std_function(key)) {
+          if (!pure_std_family(f->family) || (f->flags & ~kStdExtensible) != 0) return true;
+        } else if (!parse_conversion(*tt_, key)) {
+          return true;
+        }
+        for (const CallArg& a : c.args) {
+          if (a.is_output || !a.value) return true;
+          todo.push_back(a.value.get());
+        }
         break;
       }
       default: return true;

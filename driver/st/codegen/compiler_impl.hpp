@@ -115,6 +115,10 @@ struct Place {
   Slot idx2;
   int32_t lo2 = 0;
   uint32_t count2 = 0, stride2 = 0;
+  // FrameIdx of a rank-1 array of scalars whose DINT index is x * m + y, each a variable
+  // or a constant (LDXL/STXL): idx not made yet, one bounds check on the wrapped sum.
+  bool has_lin = false;
+  Slot lin_x, lin_m, lin_y;
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -355,7 +359,8 @@ class Compiler {
   std::unordered_map<const PouInfo*, std::pair<uint32_t, SourceLoc>> program_addr_;
   Place symbol_place(const Symbol* s, SourceLoc loc);
   Place member_place(Place base, const Ident& member, SourceLoc loc);
-  Place index_place(Place base, const IndexExpr& e);
+  Place index_place(Place base, const IndexExpr& e, bool for_write);
+  bool take_linear_index(Slot idx, Place* p);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);
   Val load_once(const Place& p);

@@ -261,7 +261,7 @@ Place Compiler::place_ref(const Expr& e, bool for_write) {
         at.slot = addr;
         return deref_place(at, base.type->target, e.loc);
       }
-      return index_place(base, ix);
+      return index_place(base, ix, for_write);
     }
     case ExprKind::Deref: {
       const auto& d = static_cast<const DerefExpr&>(e);
@@ -386,7 +386,7 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
   return p;
 }
 
-Place Compiler::index_place(Place base, const IndexExpr& e) {
+Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
   Place bad_place;
   bad_place.ok = false;
   // Set by an assignment whose right-hand side runs no call: an INT variable index cannot
@@ -500,6 +500,9 @@ Place Compiler::index_place(Place base, const IndexExpr& e) {
     }
     p.idx_cvt = idx_cvt;
     p.readonly = base.readonly;
+    // A place read now, or stored to after a right-hand side that runs no call, may read
+    // its index's variables when it is accessed.
+    if (plain && !raw16 && (!for_write || defer)) take_linear_index(p.idx, &p);
     return p;
   }
   Slot ptr = addr_of(base, e.loc);
@@ -749,7 +752,47 @@ Val Compiler::load_once(const Place& p) {
 }
 
 Slot Compiler::frame_idx(const Place& p) {
+  if (p.has_lin) {
+    Slot prod = temp(4, 4), sum = temp(4, 4);
+    emit(Op::MUL_I32, {prod, p.lin_x, p.lin_m});
+    emit(Op::ADD_I32, {sum, prod, p.lin_y});
+    def(sum);
+    return sum;
+  }
   return p.has_idx16 ? convert(p.idx16, elem(TypeKind::Int), elem(TypeKind::DInt)) : p.idx;
+}
+
+// An index linear in two variables: "MUL_I32 t, x, m; ADD_I32 idx, t, y" (or y + t), just
+// emitted for this index, in the same statement line and block, x, m and y variables or
+// constants. The two go; the access computes x * m + y (wrapping, as the two did) and
+// checks the sum once (LDXL/STXL). False: nothing changed.
+bool Compiler::take_linear_index(Slot idx, Place* p) {
+  auto& code = b_->code;
+  const uint32_t add_at = b_->last_instr, mul_at = b_->prev_instr;
+  if (add_at >= code.size() || mul_at == UINT32_MAX || mul_at + 4 != add_at || mul_at < b_->last_label_pos) return false;
+  if (code[mul_at] != static_cast<uint32_t>(Op::MUL_I32) || code[add_at] != static_cast<uint32_t>(Op::ADD_I32)) return false;
+  if (!b_->lines.empty() && b_->lines.back().first > mul_at) return false;
+  auto slot_at = [&](uint32_t word) {
+    for (const auto& [w, k] : b_->slot_fix)
+      if (w == word) return Slot{code[word], k};
+    return Slot{code[word], SK::Var};
+  };
+  auto operand = [](Slot s) { return s.kind == SK::Var || s.kind == SK::Const; };
+  const Slot sum = slot_at(add_at + 1), prod = slot_at(mul_at + 1);
+  if (idx.kind != SK::Temp || sum.kind != SK::Temp || sum.off != idx.off || prod.kind != SK::Temp) return false;
+  const Slot a = slot_at(add_at + 2), b = slot_at(add_at + 3);
+  const bool prod_first = a.kind == SK::Temp && a.off == prod.off;
+  const bool prod_second = b.kind == SK::Temp && b.off == prod.off;
+  if (prod_first == prod_second) return false;
+  const Slot x = slot_at(mul_at + 2), m = slot_at(mul_at + 3), y = prod_first ? b : a;
+  if (!operand(x) || !operand(m) || !operand(y)) return false;
+  unemit(mul_at);
+  b_->last_instr = b_->prev_instr = b_->last_def_pos = UINT32_MAX;
+  p->has_lin = true;
+  p->lin_x = x;
+  p->lin_m = m;
+  p->lin_y = y;
+  return true;
 }
 
 Val Compiler::load(const Place& p) {
@@ -814,12 +857,15 @@ Val Compiler::load(const Place& p) {
       return v;
     }
     case Place::K::FrameIdx: {
-      Slot idx = frame_idx(p);
+      Slot idx = p.has_lin ? Slot{} : frame_idx(p);
       Slot t = temp_for(p.type);
       if (p.two) {
         Op op = size == 1 ? Op::LDXX1 : size == 2 ? Op::LDXX2 : size == 4 ? Op::LDXX4 : Op::LDXX8;
         emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
                   p.count2, p.stride2, p.field});
+      } else if (p.has_lin) {
+        Op op = size == 1 ? Op::LDXL1 : size == 2 ? Op::LDXL2 : size == 4 ? Op::LDXL4 : Op::LDXL8;
+        emit(op, {t, Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count});
       } else if (p.stride) {
         Op op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
         emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
@@ -901,6 +947,11 @@ void Compiler::store(const Place& p, Slot src) {
         Op op = size == 1 ? Op::STXX1 : size == 2 ? Op::STXX2 : size == 4 ? Op::STXX4 : Op::STXX8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
                   p.stride2, p.field, src});
+        return;
+      }
+      if (p.has_lin) {
+        Op op = size == 1 ? Op::STXL1 : size == 2 ? Op::STXL2 : size == 4 ? Op::STXL4 : Op::STXL8;
+        emit(op, {Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count, src});
         return;
       }
       if (p.has_idx16 && p.stride) {

@@ -916,6 +916,21 @@ class Translator {
       else s += fmt::format("st<{}>({}, {});", t, addr, R(t, 11));
       return true;
     }
+    // An index linear in two variables, wrapping as MUL_I32 and ADD_I32 do, checked once.
+    if (name.rfind("LDXL", 0) == 0 || name.rfind("STXL", 0) == 0) {
+      int n = name.back() - '0';
+      const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
+      bool load = name[0] == 'L';
+      int at = load ? 3 : 2;
+      s = fmt::format("int32_t l = wadd<int32_t>(wmul<int32_t>({}, {}), {}); ", R("int32_t", at), R("int32_t", at + 1),
+                      R("int32_t", at + 2));
+      s += fmt::format("int64_t i = (int64_t)l - (int64_t){0}; if (i < 0 || i >= (int64_t){1}) TRAP(2, {2}, l, 0, 0); ", S(at + 3),
+                       K(at + 4), P(pc));
+      std::string addr = fmt::format("base + {} + i * {}", K(at - 1), n);
+      if (load) s += W(t, 1, fmt::format("ld<{}>({})", t, addr));
+      else s += fmt::format("st<{}>({}, {});", t, addr, R(t, 7));
+      return true;
+    }
     // Whole structure elements as blocks; a copy that cannot overlap is a memcpy.
     if (op == Op::LDXB || op == Op::STXB) {
       bool load = op == Op::LDXB;
@@ -1103,6 +1118,8 @@ class Translator {
     if (op == Op::STXB) return range(w[1], uint64_t{w[4]} * w[5]);
     if (n.rfind("STXX", 0) == 0) return range(w[1], uint64_t{w[4]} * w[5]);
     if (n.rfind("LDXX", 0) == 0) return {};
+    if (n.rfind("STXL", 0) == 0) return range(w[1], uint64_t{w[6]} * static_cast<uint64_t>(n.back() - '0'));
+    if (n.rfind("LDXL", 0) == 0) return {};
     if (n.rfind("STXS", 0) == 0) return range(w[1], uint64_t{w[4]} * w[5]);
     if (n.rfind("STX", 0) == 0) return range(w[1], uint64_t{w[4]} * static_cast<uint64_t>(n.back() - '0'));
     if (n.rfind("LDX", 0) == 0) return {};
@@ -1263,6 +1280,8 @@ class Translator {
     if (op == Op::STXB) return range(w[7], w[8]);
     if (n.rfind("LDXX", 0) == 0) return range(w[2], uint64_t{w[5]} * w[6]);
     if (n.rfind("STXX", 0) == 0) return {};
+    if (n.rfind("LDXL", 0) == 0) return range(w[2], uint64_t{w[7]} * static_cast<uint64_t>(n.back() - '0'));
+    if (n.rfind("STXL", 0) == 0) return {};
     if (n.rfind("LDXS", 0) == 0) return range(w[2], uint64_t{w[5]} * w[6]);
     if (n.rfind("LDX", 0) == 0) return range(w[2], uint64_t{w[5]} * static_cast<uint64_t>(n.back() - '0'));
     if (n.rfind("STX", 0) == 0) return {};

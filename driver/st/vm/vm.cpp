@@ -201,6 +201,8 @@ struct NativeBridge {
           // LDXX/STXX: b says which of the two indices is outside.
           else if (name.rfind("LDXX", 0) == 0) msg = b == 0 ? range(4, 5) : range(8, 9);
           else if (name.rfind("STXX", 0) == 0) msg = b == 0 ? range(3, 4) : range(7, 8);
+          else if (name.rfind("LDXL", 0) == 0) msg = range(6, 7);
+          else if (name.rfind("STXL", 0) == 0) msg = range(5, 6);
           else if (op == Op::ELEM || name.rfind("LDX", 0) == 0) msg = range(4, 5);
           else msg = range(3, 4);  // STX, STXS
           break;
@@ -789,6 +791,24 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   ELEM2_IMPL(4, uint32_t)
   ELEM2_IMPL(8, uint64_t)
 #undef ELEM2_IMPL
+  // An index linear in two variables (LDXL/STXL): x * m + y in DINT arithmetic, wrapping
+  // as MUL_I32 and ADD_I32 do, then one bounds check.
+#define ELEM_LINEAR(k)                                                                          \
+  const int32_t lin = wadd<int32_t>(wmul<int32_t>(R(int32_t, k), R(int32_t, k + 1)), R(int32_t, k + 2)); \
+  int64_t i = static_cast<int64_t>(lin) - static_cast<int32_t>(pc[k + 3]);                      \
+  if (i < 0 || i >= static_cast<int64_t>(pc[k + 4]))                                            \
+    return fail(TrapKind::IndexOutOfRange, pc,                                                  \
+                fmt::format("index {} outside {}..{}", lin, static_cast<int32_t>(pc[k + 3]),     \
+                            static_cast<int64_t>(static_cast<int32_t>(pc[k + 3])) + pc[k + 4] - 1));
+#define ELEML_IMPL(N, T)                                                                        \
+  L_LDXL##N: { ELEM_LINEAR(3) W(T, 1, ld<T>(base + pc[2] + i * N)); NEXT(7); }                  \
+  L_STXL##N: { ELEM_LINEAR(2) st<T>(base + pc[1] + i * N, R(T, 7)); NEXT(7); }
+  ELEML_IMPL(1, uint8_t)
+  ELEML_IMPL(2, uint16_t)
+  ELEML_IMPL(4, uint32_t)
+  ELEML_IMPL(8, uint64_t)
+#undef ELEML_IMPL
+#undef ELEM_LINEAR
   // Whole elements of structure arrays, copied as blocks (memmove, as LDIN/STIN do).
 L_LDXB: {
   ELEM_INDEX2(i, 3)

@@ -569,5 +569,73 @@ TEST(VmFastPaths, DintShiftCountsBehaveTheSameInTheNativeTier) {
   same_in_both_tiers(src, 25);
 }
 
+// ------------------------------------------------------------------ indices linear in two variables
+
+// An index x * m + y (variables or constants, in either order of the sum) is one
+// instruction with one bounds check; the sum wraps in DINT as MUL and ADD do, and the
+// trap names the sum. A store reads x and y at the store only when the right-hand side
+// runs no call; a pure standard function (SHR, DINT_TO_WORD) is no call, a FUNCTION with
+// a VAR_IN_OUT is, and the element is then chosen before it.
+const char* kLinear = R"(FUNCTION Bump : DINT
+VAR_IN_OUT io : DINT; END_VAR
+io := io + 1;
+Bump := 7;
+END_FUNCTION
+PROGRAM P
+VAR flat : ARRAY [0..11] OF DINT; bits : ARRAY [1..8] OF BOOL; w : ARRAY [-4..3] OF INT;
+    i, k, s, c, x : DINT; n : DINT := 4; r : DINT := 1; big : DINT := 65536; bad : DINT; END_VAR
+FOR i := 0 TO 2 DO FOR k := 0 TO 3 DO flat[i * 4 + k] := i * 10 + k; END_FOR; END_FOR;
+s := 0;
+FOR i := 0 TO 2 DO FOR k := 0 TO 3 DO s := s + flat[k + i * n]; END_FOR; END_FOR;
+FOR i := 0 TO 3 DO bits[i * 2 + 1] := SHR(DINT_TO_WORD(i), 0) = WORD#2; bits[i * 2 + 2] := i = 1; END_FOR;
+c := 0;
+FOR i := 0 TO 7 DO IF bits[i * r + 1] THEN c := c + i; END_IF; END_FOR;
+i := 1; k := 2;
+flat[i * n + k] := Bump(io := k);  (* flat[6] := 7, then k = 3 *)
+x := flat[big * 65536 + 5];        (* 2^32 wraps to 0: flat[5]; big = 3 traps *)
+w[bad * 2 + r] := INT#9;           (* w[1]; bad = 2 traps *)
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, LinearIndicesAreOneInstructionWithOneCheck) {
+  Prog p(kLinear);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_NE(std::string::npos, dis.find("STXL4")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("LDXL4")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("STXL1")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("LDXL1")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("STXL2")) << dis;
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(4 * (0 + 10 + 20) + 3 * (0 + 1 + 2 + 3), p.get("P.s"));
+  EXPECT_EQ(1, p.get("P.bits[5]"));  // i = 2
+  EXPECT_EQ(1, p.get("P.bits[4]"));  // i = 1
+  EXPECT_EQ(0, p.get("P.bits[3]"));
+  EXPECT_EQ(3 + 4, p.get("P.c"));
+  EXPECT_EQ(7, p.get("P.flat[6]"));   // the element chosen before Bump
+  EXPECT_EQ(13, p.get("P.flat[7]"));  // untouched
+  EXPECT_EQ(3, p.get("P.k"));
+  EXPECT_EQ(11, p.get("P.x"));
+  EXPECT_EQ(9, p.get("P.w[1]"));
+  p.set("P.big", 3);
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ(TrapKind::IndexOutOfRange, p.m->trap().kind);
+  EXPECT_EQ("index 196613 outside 0..11", p.m->trap().message);
+  EXPECT_EQ(17u, p.m->trap().loc.line);
+  p.set("P.big", 65536);
+  p.set("P.bad", 2);
+  EXPECT_FALSE(p.scan());
+  EXPECT_EQ("index 5 outside -4..3", p.m->trap().message);
+  EXPECT_EQ(18u, p.m->trap().loc.line);
+}
+
+TEST(VmFastPaths, LinearIndicesBehaveTheSameInTheNativeTier) {
+  std::string src = kLinear;
+  // big alternates between wrapping and trapping; bad walks into and past the bounds.
+  src.replace(src.find("i := 1; k := 2;"), 0,
+              "IF big = 65536 THEN big := 3; ELSE big := 65536; END_IF; bad := (bad + 1) MOD 4;\n");
+  same_in_both_tiers(src, 12);
+}
+
 }  // namespace
 }  // namespace plcfi::st
