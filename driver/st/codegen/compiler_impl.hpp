@@ -361,6 +361,7 @@ class Compiler {
   Place member_place(Place base, const Ident& member, SourceLoc loc);
   Place index_place(Place base, const IndexExpr& e, bool for_write);
   bool take_linear_index(Slot idx, Place* p);
+  std::optional<Val> multiply_add(Slot a, Slot b, const Type* t);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);
   Val load_once(const Place& p);

@@ -1029,7 +1029,10 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     return in_register(v);
   }
   switch (e.op) {
-    case BinaryOp::Add: return in_register(emit_bin(Op::ADD_I8, t, a, b, t));
+    case BinaryOp::Add:
+      if (t->storage() == Storage::I32)
+        if (auto v = multiply_add(a, b, t)) return in_register(*v);
+      return in_register(emit_bin(Op::ADD_I8, t, a, b, t));
     case BinaryOp::Sub: return in_register(emit_bin(Op::SUB_I8, t, a, b, t));
     case BinaryOp::Mul: return in_register(emit_bin(Op::MUL_I8, t, a, b, t));
     case BinaryOp::Div: return in_register(emit_bin(Op::DIV_I8, t, a, b, t));
@@ -1049,6 +1052,29 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     }
     default: return op_error();
   }
+}
+
+// A DINT sum one of whose operands is the product just computed ("MUL_I32 p, x, y" the
+// last instruction, in the same line and block, defining the temporary p): one MADD_I32
+// computes x * y + z, wrapping as the two do. Nothing changed when it does not apply.
+std::optional<Val> Compiler::multiply_add(Slot a, Slot b, const Type* t) {
+  auto& code = b_->code;
+  const uint32_t at = b_->last_instr;
+  if (at >= code.size() || code[at] != static_cast<uint32_t>(Op::MUL_I32) || b_->last_def_pos != at || b_->last_label_pos > at)
+    return std::nullopt;
+  if (!b_->lines.empty() && b_->lines.back().first > at) return std::nullopt;
+  const Slot p = b_->last_def;
+  auto is_p = [&](Slot s) { return s.kind == SK::Temp && p.kind == SK::Temp && s.off == p.off; };
+  if (is_p(a) == is_p(b)) return std::nullopt;
+  const Slot z = is_p(a) ? b : a;
+  auto [x, y] = unemit(at);
+  Slot d = temp_for(t);
+  emit(Op::MADD_I32, {d, x, y, z});
+  def(d);
+  Val v;
+  v.type = t;
+  v.slot = d;
+  return v;
 }
 
 // The type CODESYS computes a mixed operation in (REAL * BYTE, INT + UDINT, WORD AND

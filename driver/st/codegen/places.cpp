@@ -753,40 +753,37 @@ Val Compiler::load_once(const Place& p) {
 
 Slot Compiler::frame_idx(const Place& p) {
   if (p.has_lin) {
-    Slot prod = temp(4, 4), sum = temp(4, 4);
-    emit(Op::MUL_I32, {prod, p.lin_x, p.lin_m});
-    emit(Op::ADD_I32, {sum, prod, p.lin_y});
+    Slot sum = temp(4, 4);
+    emit(Op::MADD_I32, {sum, p.lin_x, p.lin_m, p.lin_y});
     def(sum);
     return sum;
   }
   return p.has_idx16 ? convert(p.idx16, elem(TypeKind::Int), elem(TypeKind::DInt)) : p.idx;
 }
 
-// An index linear in two variables: "MUL_I32 t, x, m; ADD_I32 idx, t, y" (or y + t), just
-// emitted for this index, in the same statement line and block, x, m and y variables or
-// constants. The two go; the access computes x * m + y (wrapping, as the two did) and
-// checks the sum once (LDXL/STXL). False: nothing changed.
+// An index linear in two variables: "MADD_I32 idx, x, m, y" (x * m + y, see
+// multiply_add), just emitted for this index, in the same statement line and block, x, m
+// and y variables or constants. It goes; the access computes x * m + y (wrapping, as it
+// did) and checks the sum once (LDXL/STXL). False: nothing changed.
 bool Compiler::take_linear_index(Slot idx, Place* p) {
   auto& code = b_->code;
-  const uint32_t add_at = b_->last_instr, mul_at = b_->prev_instr;
-  if (add_at >= code.size() || mul_at == UINT32_MAX || mul_at + 4 != add_at || mul_at < b_->last_label_pos) return false;
-  if (code[mul_at] != static_cast<uint32_t>(Op::MUL_I32) || code[add_at] != static_cast<uint32_t>(Op::ADD_I32)) return false;
-  if (!b_->lines.empty() && b_->lines.back().first > mul_at) return false;
+  const uint32_t at = b_->last_instr;
+  if (at >= code.size() || code[at] != static_cast<uint32_t>(Op::MADD_I32) || at < b_->last_label_pos) return false;
+  if (!b_->lines.empty() && b_->lines.back().first > at) return false;
   auto slot_at = [&](uint32_t word) {
     for (const auto& [w, k] : b_->slot_fix)
       if (w == word) return Slot{code[word], k};
     return Slot{code[word], SK::Var};
   };
   auto operand = [](Slot s) { return s.kind == SK::Var || s.kind == SK::Const; };
-  const Slot sum = slot_at(add_at + 1), prod = slot_at(mul_at + 1);
-  if (idx.kind != SK::Temp || sum.kind != SK::Temp || sum.off != idx.off || prod.kind != SK::Temp) return false;
-  const Slot a = slot_at(add_at + 2), b = slot_at(add_at + 3);
-  const bool prod_first = a.kind == SK::Temp && a.off == prod.off;
-  const bool prod_second = b.kind == SK::Temp && b.off == prod.off;
-  if (prod_first == prod_second) return false;
-  const Slot x = slot_at(mul_at + 2), m = slot_at(mul_at + 3), y = prod_first ? b : a;
+  const Slot sum = slot_at(at + 1), x = slot_at(at + 2), m = slot_at(at + 3), y = slot_at(at + 4);
+  if (idx.kind != SK::Temp || sum.kind != SK::Temp || sum.off != idx.off) return false;
   if (!operand(x) || !operand(m) || !operand(y)) return false;
-  unemit(mul_at);
+  for (auto it = b_->slot_fix.begin(); it != b_->slot_fix.end();) {
+    if (it->first >= at) it = b_->slot_fix.erase(it);
+    else ++it;
+  }
+  code.resize(at);
   b_->last_instr = b_->prev_instr = b_->last_def_pos = UINT32_MAX;
   p->has_lin = true;
   p->lin_x = x;

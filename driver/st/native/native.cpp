@@ -388,6 +388,7 @@ class Translator {
   static const TypedFamily* typed_family(std::string_view op_name) {
     static const TypedFamily kFamilies[] = {
         {"ADD", TypedFamily::kNever},    {"SUB", TypedFamily::kNever},    {"MUL", TypedFamily::kNever},
+        {"MADD", TypedFamily::kNever},
         {"DIV", TypedFamily::kIntegers}, {"NEG", TypedFamily::kNever},    {"EQ", TypedFamily::kNever},
         {"NE", TypedFamily::kNever},     {"LT", TypedFamily::kNever},     {"LE", TypedFamily::kNever},
         {"GT", TypedFamily::kNever},     {"GE", TypedFamily::kNever},     {"JLT", TypedFamily::kNever},
@@ -979,6 +980,7 @@ class Translator {
     if (fam == "ADD") bin("wadd");
     else if (fam == "SUB") bin("wsub");
     else if (fam == "MUL") bin("wmul");
+    else if (fam == "MADD") s = W(C, 1, fmt::format("(wadd<{0}>(wmul<{0}>({1}, {2}), {3}))", C, R(C, 2), R(C, 3), R(C, 4)));
     else if (fam == "DIV") {
       if (is_int(tn))
         s = fmt::format("{0} d = {1}; if (d == ({0})0) TRAP(1, {2}, 0, 0, 0); ", C, R(C, 3), P(pc)) +

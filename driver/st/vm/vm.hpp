@@ -144,7 +144,7 @@ class Machine {
   const std::string& assert_message() const { return assert_message_; }
 
   // The superinstructions the interpreter runs (see run()): (pc of the first instruction,
-  // the instructions it runs, as "MUL_I32+ADD_I32"). Empty until the first call.
+  // the instructions it runs, as "MADD_I32+MODK_I32"). Empty until the first call.
   std::vector<std::pair<uint32_t, std::string>> superinstructions() const;
 
   // The native tier (native/native.hpp): entries it has run natively, the rest in the

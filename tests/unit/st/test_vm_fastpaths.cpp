@@ -637,5 +637,38 @@ TEST(VmFastPaths, LinearIndicesBehaveTheSameInTheNativeTier) {
   same_in_both_tiers(src, 12);
 }
 
+// ------------------------------------------------------------------ multiply-accumulate
+
+// A DINT sum with a product just computed as one operand is one MADD_I32, in either
+// order, after a conversion, and for the second of two products; it wraps as MUL and ADD.
+const char* kMadd = R"(PROGRAM P
+VAR a : ARRAY [0..3] OF DINT := [3, -5, 7, 100000]; s, t, u, v, x : DINT; big : DINT := 65536; k : INT := 3; END_VAR
+s := 0;
+FOR x := 0 TO 3 DO s := s + a[x] * a[3 - x]; END_FOR;
+t := a[0] * a[1] + a[2] * a[3];
+u := big * big + 1;
+v := 2 + INT_TO_DINT(k) * big;
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, MultiplyAccumulateIsOneInstructionThatWraps) {
+  Prog p(kMadd);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_EQ(std::string::npos, dis.find(" ADD_I32")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("MADD_I32")) << dis;
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(3 * 100000 - 5 * 7 + 7 * -5 + 100000 * 3, p.get("P.s"));
+  EXPECT_EQ(-15 + 700000, p.get("P.t"));
+  EXPECT_EQ(1, p.get("P.u"));  // 2^32 wraps to 0
+  EXPECT_EQ(2 + 3 * 65536, p.get("P.v"));
+}
+
+TEST(VmFastPaths, MultiplyAccumulateBehavesTheSameInTheNativeTier) {
+  std::string src = kMadd;
+  src.replace(src.find("s := 0;"), 0, "big := big * 3 + 7; k := k + 1000;\n");
+  same_in_both_tiers(src, 20);
+}
+
 }  // namespace
 }  // namespace plcfi::st

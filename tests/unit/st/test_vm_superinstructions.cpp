@@ -232,8 +232,8 @@ TEST(VmSuperinstructions, ChainsHandOnTheValueTheSourceComputes) {
   Prog p(kChains);
   ASSERT_TRUE(p.ok());
   ASSERT_TRUE(p.scan()) << p.m->trap().message;
-  for (const char* name : {"MUL_I32+ADD_I32+MODK_I32", "MUL_I32+DIVK_I32+JGE_I32", "SUB_F32+MUL_F32+ADD_F32",
-                           "MUL_F32+ADD_F32+JNLT_F32", "CVT_I16_I32+MUL_I32+ADD_I32", "MOV4+MOV4+CALL",
+  for (const char* name : {"MADD_I32+MODK_I32", "MUL_I32+DIVK_I32+JGE_I32", "SUB_F32+MUL_F32+ADD_F32",
+                           "MUL_F32+ADD_F32+JNLT_F32", "CVT_I16_I32+MADD_I32", "MOV4+MOV4+CALL",
                            "LDXH4+JGE_I32", "JNLT_F32+COV", "EQ_I16+BAND"})
     EXPECT_LE(1u, p.uses(name)) << name << " not used:\n" << p.all_names();
   // The same sums, computed here from the source.
