@@ -29,6 +29,29 @@ bool pure_std_family(StdFamily f) {
 }
 }  // namespace
 
+// The type of a path made of a variable, elements and fields (`a`, `a[i].b`, `s.c[j]`), or
+// null for anything else: a path that reads no property and calls nothing.
+const Type* Compiler::field_path_type(const Expr& e) const {
+  switch (e.kind) {
+    case ExprKind::Name: {
+      const Symbol* s = lookup(canon(static_cast<const NameExpr&>(e).name.text));
+      return s && s->kind == SymKind::Var ? s->type : nullptr;
+    }
+    case ExprKind::Index: {
+      const Type* t = field_path_type(*static_cast<const IndexExpr&>(e).base);
+      return t && t->kind == TypeKind::Array ? t->elem : nullptr;
+    }
+    case ExprKind::Member: {
+      const auto& m = static_cast<const MemberExpr&>(e);
+      const Type* t = field_path_type(*m.base);
+      if (!t || (t->kind != TypeKind::Struct && t->kind != TypeKind::Pou)) return nullptr;
+      const Field* f = t->field(m.member.text);
+      return f ? f->type : nullptr;
+    }
+    default: return nullptr;
+  }
+}
+
 bool Compiler::may_call(const Expr& root) const {
   std::vector<const Expr*> todo{&root};
   while (!todo.empty()) {
@@ -46,12 +69,12 @@ bool Compiler::may_call(const Expr& root) const {
         break;
       }
       case ExprKind::Member: {
+        // A field of a variable, of an element, of a field, ...: no call. Anything else
+        // (a property, a method's result) may be one.
         const auto& m = static_cast<const MemberExpr&>(*e);
-        if (m.base->kind != ExprKind::Name) return true;
-        const Symbol* s = lookup(canon(static_cast<const NameExpr&>(*m.base).name.text));
-        if (!s || s->kind != SymKind::Var || !s->type) return true;
-        if (s->type->kind != TypeKind::Struct && s->type->kind != TypeKind::Pou) return true;
-        if (!s->type->field(m.member.text)) return true;
+        const Type* t = field_path_type(*m.base);
+        if (!t || (t->kind != TypeKind::Struct && t->kind != TypeKind::Pou) || !t->field(m.member.text)) return true;
+        todo.push_back(m.base.get());
         break;
       }
       case ExprKind::BitAccess: todo.push_back(static_cast<const BitAccessExpr&>(*e).base.get()); break;

@@ -119,6 +119,9 @@ struct Place {
   // or a constant (LDXL/STXL): idx not made yet, one bounds check on the wrapped sum.
   bool has_lin = false;
   Slot lin_x, lin_m, lin_y;
+  // FrameIdx with two indices, each a FOR counter proven to stay inside its dimension
+  // (LDXXN/STXXN: no check at run time).
+  bool proven = false;
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -386,6 +389,16 @@ class Compiler {
   void capture_eno(const CallExpr& c, const Val& enabled);
   const PouInfo* callee_pou(const Expr& callee);
   bool may_call(const Expr& e) const;
+  const Type* field_path_type(const Expr& e) const;
+  // Bounds-check elimination: the values a FOR loop's counter takes inside its body, when
+  // the body can change it by no means (stmt.cpp). index_place asks proven_range.
+  struct CounterRange {
+    Slot slot;
+    int64_t lo = 0, hi = 0;
+  };
+  std::vector<CounterRange> counters_;
+  const CounterRange* proven_range(Slot s) const;
+  bool keeps_counter(const StmtList& body, const std::string& counter) const;
   Val call_function(PouInfo* f, const CallExpr& c);
   // The frame set-up of a FUNCTION call: the template's bytes this call needs (calls.cpp).
   void init_function_frame(PouInfo* f, Slot frame, const std::vector<const Symbol*>& stored);

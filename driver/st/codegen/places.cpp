@@ -386,6 +386,14 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
   return p;
 }
 
+namespace {
+// LDXXN/STXXN: the lower bounds folded into the element's offset (a 32-bit two's-complement
+// displacement), so the instruction only multiplies and adds.
+uint32_t unchecked_field(const Place& p) {
+  return static_cast<uint32_t>(static_cast<int64_t>(p.field) - int64_t{p.lo} * p.stride - int64_t{p.lo2} * p.stride2);
+}
+}  // namespace
+
 Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
   Place bad_place;
   bad_place.ok = false;
@@ -497,6 +505,11 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
       p.lo2 = static_cast<int32_t>(t->dims[d1].lo);
       p.count2 = static_cast<uint32_t>(t->dims[d1].hi - t->dims[d1].lo + 1);
       p.stride2 = static_cast<uint32_t>(stride[d1]);
+      // Both indices FOR counters that stay inside their dimensions (see for_stmt).
+      const CounterRange* r0 = proven_range(dyn[0].second);
+      const CounterRange* r1 = proven_range(dyn[1].second);
+      p.proven = r0 && r1 && r0->lo >= t->dims[d0].lo && r0->hi <= t->dims[d0].hi &&
+                 r1->lo >= t->dims[d1].lo && r1->hi <= t->dims[d1].hi;
     }
     p.idx_cvt = idx_cvt;
     p.readonly = base.readonly;
@@ -856,7 +869,11 @@ Val Compiler::load(const Place& p) {
     case Place::K::FrameIdx: {
       Slot idx = p.has_lin ? Slot{} : frame_idx(p);
       Slot t = temp_for(p.type);
-      if (p.two) {
+      if (p.two && p.proven) {
+        Op op = size == 1 ? Op::LDXXN1 : size == 2 ? Op::LDXXN2 : size == 4 ? Op::LDXXN4 : Op::LDXXN8;
+        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
+                  p.count2, p.stride2, unchecked_field(p)});
+      } else if (p.two) {
         Op op = size == 1 ? Op::LDXX1 : size == 2 ? Op::LDXX2 : size == 4 ? Op::LDXX4 : Op::LDXX8;
         emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
                   p.count2, p.stride2, p.field});
@@ -940,6 +957,12 @@ void Compiler::store(const Place& p, Slot src) {
         default: emit(Op::STIN, {p.ptr, p.off, src, size}); return;
       }
     case Place::K::FrameIdx: {
+      if (p.two && p.proven) {
+        Op op = size == 1 ? Op::STXXN1 : size == 2 ? Op::STXXN2 : size == 4 ? Op::STXXN4 : Op::STXXN8;
+        emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
+                  p.stride2, unchecked_field(p), src});
+        return;
+      }
       if (p.two) {
         Op op = size == 1 ? Op::STXX1 : size == 2 ? Op::STXX2 : size == 4 ? Op::STXX4 : Op::STXX8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,

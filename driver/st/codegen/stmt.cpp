@@ -600,6 +600,85 @@ void Compiler::case_stmt(const CaseStmt& s) {
   bind(end);
 }
 
+const Compiler::CounterRange* Compiler::proven_range(Slot s) const {
+  for (auto it = counters_.rbegin(); it != counters_.rend(); ++it)
+    if (it->slot.off == s.off && it->slot.kind == s.kind) return &*it;
+  return nullptr;
+}
+
+// True when nothing in `body` can change the local variable `counter` (canonical name):
+// no call other than a standard function that only computes (a method or action of this
+// POU could write it; a VAR_IN_OUT or output could reach it), and no assignment whose
+// target is the counter, or goes through a pointer or reference (which could point at it).
+bool Compiler::keeps_counter(const StmtList& body, const std::string& counter) const {
+  // A variable, element or field other than the counter, reached through no pointer or
+  // reference (an assignment to a REFERENCE writes what it refers to).
+  auto target_ok = [&](const Expr& lhs) {
+    for (const Expr* e = &lhs;;) {
+      if (e->kind == ExprKind::BitAccess) {
+        e = static_cast<const BitAccessExpr&>(*e).base.get();
+        continue;
+      }
+      const Type* t = field_path_type(*e);
+      if (!t || t->kind == TypeKind::Ref || t->kind == TypeKind::Interface) return false;
+      if (e->kind == ExprKind::Member) e = static_cast<const MemberExpr&>(*e).base.get();
+      else if (e->kind == ExprKind::Index) e = static_cast<const IndexExpr&>(*e).base.get();
+      else if (e->kind == ExprKind::Name) return canon(static_cast<const NameExpr&>(*e).name.text) != counter && !may_call(lhs);
+      else return false;
+    }
+  };
+  for (const StmtPtr& sp : body) {
+    const Stmt& st = *sp;
+    switch (st.kind) {
+      case StmtKind::Assign: {
+        const auto& a = static_cast<const AssignStmt&>(st);
+        if (!target_ok(*a.lhs) || may_call(*a.rhs)) return false;
+        break;
+      }
+      case StmtKind::If: {
+        const auto& i = static_cast<const IfStmt&>(st);
+        for (const auto& arm : i.arms)
+          if (may_call(*arm.cond) || !keeps_counter(arm.body, counter)) return false;
+        if (i.else_body && !keeps_counter(*i.else_body, counter)) return false;
+        break;
+      }
+      case StmtKind::Case: {
+        const auto& c = static_cast<const CaseStmt&>(st);
+        if (may_call(*c.selector)) return false;
+        for (const auto& arm : c.arms)
+          if (!keeps_counter(arm.body, counter)) return false;
+        if (c.else_body && !keeps_counter(*c.else_body, counter)) return false;
+        break;
+      }
+      case StmtKind::For: {
+        const auto& f = static_cast<const ForStmt&>(st);
+        if (!target_ok(*f.var) || may_call(*f.from) || may_call(*f.to) || (f.by && may_call(*f.by)) ||
+            !keeps_counter(f.body, counter))
+          return false;
+        break;
+      }
+      case StmtKind::While: {
+        const auto& w = static_cast<const WhileStmt&>(st);
+        if (may_call(*w.cond) || !keeps_counter(w.body, counter)) return false;
+        break;
+      }
+      case StmtKind::Repeat: {
+        const auto& r = static_cast<const RepeatStmt&>(st);
+        if (may_call(*r.until) || !keeps_counter(r.body, counter)) return false;
+        break;
+      }
+      case StmtKind::Exit:
+      case StmtKind::Continue:
+      case StmtKind::Return:
+      case StmtKind::Empty:
+      case StmtKind::Jump:  // leaves the loop; a label is never inside one
+        break;
+      default: return false;  // calls, labels, test-file statements
+    }
+  }
+  return true;
+}
+
 void Compiler::for_stmt(const ForStmt& s) {
   Place var = place(*s.var, true);
   if (!var.ok) return;
@@ -652,7 +731,29 @@ void Compiler::for_stmt(const ForStmt& s) {
     bind(body);
     write_out();
     b_->loops.push_back({exit, cont});
+    // A DINT local counted in place, with bounds that are constants or counters proven
+    // the same way, by a constant step, in a body that cannot change it: inside the body
+    // it lies between the bounds, and an index by it needs no check there.
+    const size_t outer = counters_.size();
+    if (direct && st == Storage::I32 && s.var->kind == ExprKind::Name) {
+      auto bounds = [&](const Val& v, int64_t* lo, int64_t* hi) {
+        if (v.is_const) {
+          *lo = *hi = v.c.i;
+          return v.c.k == ConstV::K::Int;
+        }
+        const CounterRange* r = proven_range(v.slot);
+        if (!r) return false;
+        *lo = r->lo;
+        *hi = r->hi;
+        return true;
+      };
+      int64_t flo, fhi, tlo, thi;
+      if (bounds(from, &flo, &fhi) && bounds(to, &tlo, &thi) &&
+          keeps_counter(s.body, canon(static_cast<const NameExpr&>(*s.var).name.text)))
+        counters_.push_back({iv, down ? tlo : flo, down ? fhi : thi});
+    }
     stmts(s.body);
+    counters_.resize(outer);
     b_->loops.pop_back();
     bind(cont);
     read_back();

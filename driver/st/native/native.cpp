@@ -906,6 +906,20 @@ class Translator {
       const char* t = n == 1 ? "uint8_t" : n == 2 ? "uint16_t" : n == 4 ? "uint32_t" : "uint64_t";
       bool load = name[0] == 'L';
       int at = load ? 3 : 2;
+      if (name[4] == 'N') {
+        // Indices the compiler proved in range: no check, but the C++ compiler is told the
+        // range; the lower bounds are in the offset.
+        s.clear();
+        for (int d = 0; d < 2; ++d) {
+          int idx = at + 4 * d;
+          s += fmt::format("int64_t i{0} = {1}; if (i{0} < (int64_t){2} || i{0} - (int64_t){2} >= (int64_t){3}) __builtin_unreachable(); ",
+                           d, R("int32_t", idx), S(idx + 1), K(idx + 2));
+        }
+        std::string addr = fmt::format("base + ((int64_t){} + i0 * {} + i1 * {} + (int64_t)({}))", K(at - 1), K(at + 3), K(at + 7),
+                                       S(at + 8));
+        s += load ? W(t, 1, fmt::format("ld<{}>({})", t, addr)) : fmt::format("st<{}>({}, {});", t, addr, R(t, 11));
+        return true;
+      }
       s.clear();
       for (int d = 0; d < 2; ++d) {
         int idx = at + 4 * d;

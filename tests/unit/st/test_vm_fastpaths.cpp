@@ -390,10 +390,11 @@ TEST(VmFastPaths, RankTwoAccessIsOneInstructionAndChecksEachIndex) {
   Prog p(kRank2);
   ASSERT_TRUE(p.ok());
   std::string dis = p.disasm();
-  EXPECT_NE(std::string::npos, dis.find("LDXX4")) << dis;
-  EXPECT_NE(std::string::npos, dis.find("STXX4")) << dis;
-  EXPECT_NE(std::string::npos, dis.find("LDXX1")) << dis;   // g[i, j].on
-  EXPECT_NE(std::string::npos, dis.find("STXX2")) << dis;   // cube[i, 1, j]
+  EXPECT_NE(std::string::npos, dis.find("LDXX4 ")) << dis;   // m[bi, bj]
+  // Inside FOR loops over the arrays' own bounds, the indices need no check (below).
+  EXPECT_NE(std::string::npos, dis.find("STXXN4")) << dis;  // m[i, j] :=
+  EXPECT_NE(std::string::npos, dis.find("LDXXN1")) << dis;  // g[i, j].on
+  EXPECT_NE(std::string::npos, dis.find("STXXN2")) << dis;  // cube[i, 1, j]
   EXPECT_NE(std::string::npos, dis.find("LDXB")) << dis;
   EXPECT_NE(std::string::npos, dis.find("STXB")) << dis;
   EXPECT_EQ(std::string::npos, dis.find("ELEM")) << dis;
@@ -425,6 +426,100 @@ TEST(VmFastPaths, RankTwoAccessBehavesTheSameInTheNativeTier) {
   // bi and bj walk through and past their bounds: both tiers trap alike, on either index.
   src.replace(src.find("x := m[bi, bj];"), 15, "bi := (bi + 1) MOD 5; bj := (bj + 2) MOD 5 - 1; x := m[bi, bj];");
   same_in_both_tiers(src, 12);
+}
+
+// ------------------------------------------------------------------ FOR counters proven in range
+
+// An index that is a FOR loop's DINT counter needs no check inside the body when the loop's
+// bounds (constants, or counters of enclosing loops proven the same way) lie inside the
+// dimension and nothing in the body can change the counter. Every other case keeps the check.
+const char* kProven = R"(PROGRAM P
+VAR m : ARRAY [1..3, -1..2] OF DINT; q : ARRAY [0..4, 0..4] OF DINT;
+    i, j : DINT; s, t, u : DINT; n : DINT := 3; END_VAR
+FOR i := 1 TO 3 DO FOR j := -1 TO 2 DO m[i, j] := i * 10 + j; END_FOR; END_FOR;
+FOR i := 0 TO 4 DO FOR j := 0 TO 4 DO q[i, j] := i * 5 + j; END_FOR; END_FOR;
+s := 0;
+FOR i := 3 TO 1 BY -1 DO FOR j := 2 TO -1 BY -1 DO s := s * 3 + m[i, j]; END_FOR; END_FOR;
+t := 0;
+FOR i := 1 TO 4 DO FOR j := 0 TO i DO t := t + q[i, j] * (i - j) + q[j, i]; END_FOR; END_FOR;
+u := 0;
+FOR i := 0 TO 2 DO FOR j := 0 TO 2 DO IF q[i, j] > 3 THEN u := u + q[i, j]; ELSE u := u - 1; END_IF; END_FOR; END_FOR;
+END_PROGRAM
+)";
+
+TEST(VmFastPaths, ForCountersInRangeNeedNoIndexCheck) {
+  Prog p(kProven);
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_EQ(std::string::npos, dis.find("LDXX4 ")) << dis;
+  EXPECT_EQ(std::string::npos, dis.find("STXX4 ")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("LDXXN4")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("STXXN4")) << dis;
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  // The same sums, computed here from the definitions.
+  int64_t s = 0, t = 0, u = 0;
+  auto m = [](int64_t i, int64_t j) { return i * 10 + j; };
+  auto q = [](int64_t i, int64_t j) { return i * 5 + j; };
+  for (int64_t i = 3; i >= 1; --i)
+    for (int64_t j = 2; j >= -1; --j) s = static_cast<int32_t>(s * 3 + m(i, j));
+  for (int64_t i = 1; i <= 4; ++i)
+    for (int64_t j = 0; j <= i; ++j) t += q(i, j) * (i - j) + q(j, i);
+  for (int64_t i = 0; i <= 2; ++i)
+    for (int64_t j = 0; j <= 2; ++j) u += q(i, j) > 3 ? q(i, j) : -1;
+  EXPECT_EQ(s, p.get("P.s"));
+  EXPECT_EQ(t, p.get("P.t"));
+  EXPECT_EQ(u, p.get("P.u"));
+  EXPECT_EQ(9, p.get("P.m[1,-1]"));  // the lower bounds folded into the offset
+  EXPECT_EQ(32, p.get("P.m[3,2]"));
+  same_in_both_tiers(kProven, 3);
+}
+
+// Each loop below could reach outside q (or changes its counter, or may): the check stays,
+// and where the index does leave the array, both tiers trap with the usual message.
+TEST(VmFastPaths, IndexChecksStayWhereTheCounterIsNotProven) {
+  struct Case {
+    const char* what;
+    const char* body;   // statements; q is ARRAY [0..4, 0..4] OF DINT
+    bool proven;        // the check is left out
+    const char* trap;   // "" when the loop stays inside q
+  };
+  const Case cases[] = {
+      {"the proven case, for contrast", "FOR i := 0 TO 4 DO s := s + q[i, i]; END_FOR;", true, ""},
+      {"a bound outside the dimension", "FOR i := 0 TO 5 DO s := s + q[i, i]; END_FOR;", false, "index 5 outside 0..4"},
+      {"a bound that is a variable", "FOR i := 0 TO n DO s := s + q[i, i]; END_FOR;", false, "index 5 outside 0..4"},
+      {"a counter bounded by a variable", "FOR i := 0 TO n DO FOR j := 0 TO i DO s := s + q[j, j]; END_FOR; END_FOR;", false,
+       "index 5 outside 0..4"},
+      {"the counter assigned", "FOR i := 0 TO 4 DO s := s + q[i, i]; i := i + 2; END_FOR;", false, ""},
+      {"the counter assigned in a nested loop",
+       "FOR i := 0 TO 4 DO FOR j := 0 TO 1 DO IF i = 1 THEN i := 6; END_IF; END_FOR; s := s + q[i, i]; END_FOR;", false,
+       "index 6 outside 0..4"},
+      {"a call of a function block", "FOR i := 0 TO 4 DO f(CLK := TRUE); s := s + q[i, i]; END_FOR;", false, ""},
+      {"a call of a function", "FOR i := 0 TO 4 DO s := s + Twice(i) + q[i, i]; END_FOR;", false, ""},
+      {"a write through a pointer", "p := ADR(i); FOR i := 0 TO 4 DO IF i = 1 THEN p^ := 7; END_IF; s := s + q[i, i]; END_FOR;",
+       false, "index 7 outside 0..4"},
+  };
+  for (const Case& c : cases) {
+    std::string src = std::string(R"(FUNCTION Twice : DINT
+VAR_INPUT x : DINT; END_VAR
+Twice := 2 * x;
+END_FUNCTION
+PROGRAM P
+VAR q : ARRAY [0..4, 0..4] OF DINT; i, j, s : DINT; n : DINT := 9; f : R_TRIG; p : POINTER TO DINT; END_VAR
+)") + c.body + "\nEND_PROGRAM\n";
+    Prog prog(src);
+    ASSERT_TRUE(prog.ok()) << c.what;
+    std::string dis = prog.disasm();
+    EXPECT_EQ(c.proven, dis.find("LDXXN4") != std::string::npos) << c.what << "\n" << dis;
+    EXPECT_EQ(c.proven, dis.find("LDXX4 ") == std::string::npos) << c.what << "\n" << dis;
+    bool ok = prog.scan();
+    if (*c.trap) {
+      ASSERT_FALSE(ok) << c.what;
+      EXPECT_EQ(c.trap, prog.m->trap().message) << c.what;
+    } else {
+      EXPECT_TRUE(ok) << c.what << ": " << prog.m->trap().message;
+    }
+    same_in_both_tiers(src, 2);
+  }
 }
 
 // ------------------------------------------------------------------ loops tested at the bottom
