@@ -516,6 +516,11 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
     // A place read now, or stored to after a right-hand side that runs no call, may read
     // its index's variables when it is accessed.
     if (plain && !raw16 && (!for_write || defer)) take_linear_index(p.idx, &p);
+    // One index, a FOR counter that stays inside the dimension (see for_stmt).
+    if (dyn.size() == 1 && !raw16 && !p.has_lin) {
+      const CounterRange* r = proven_range(p.idx);
+      p.proven = r && r->lo >= t->dims[d0].lo && r->hi <= t->dims[d0].hi;
+    }
     return p;
   }
   Slot ptr = addr_of(base, e.loc);
@@ -880,9 +885,15 @@ Val Compiler::load(const Place& p) {
       } else if (p.has_lin) {
         Op op = size == 1 ? Op::LDXL1 : size == 2 ? Op::LDXL2 : size == 4 ? Op::LDXL4 : Op::LDXL8;
         emit(op, {t, Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count});
+      } else if (p.stride && p.proven) {
+        Op op = size == 1 ? Op::LDXSN1 : size == 2 ? Op::LDXSN2 : size == 4 ? Op::LDXSN4 : Op::LDXSN8;
+        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
       } else if (p.stride) {
         Op op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
         emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+      } else if (p.proven) {
+        Op op = size == 1 ? Op::LDXN1 : size == 2 ? Op::LDXN2 : size == 4 ? Op::LDXN4 : Op::LDXN8;
+        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count});
       } else {
         Op op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
         emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count});
@@ -984,12 +995,18 @@ void Compiler::store(const Place& p, Slot src) {
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, src});
         return;
       }
+      if (p.stride && p.proven) {
+        Op op = size == 1 ? Op::STXSN1 : size == 2 ? Op::STXSN2 : size == 4 ? Op::STXSN4 : Op::STXSN8;
+        emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        return;
+      }
       if (p.stride) {
         Op op = size == 1 ? Op::STXS1 : size == 2 ? Op::STXS2 : size == 4 ? Op::STXS4 : Op::STXS8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
         return;
       }
-      Op op = size == 1 ? Op::STX1 : size == 2 ? Op::STX2 : size == 4 ? Op::STX4 : Op::STX8;
+      Op op = p.proven ? (size == 1 ? Op::STXN1 : size == 2 ? Op::STXN2 : size == 4 ? Op::STXN4 : Op::STXN8)
+                       : (size == 1 ? Op::STX1 : size == 2 ? Op::STX2 : size == 4 ? Op::STX4 : Op::STX8);
       emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, src});
       return;
     }

@@ -435,7 +435,10 @@ TEST(VmFastPaths, RankTwoAccessBehavesTheSameInTheNativeTier) {
 // dimension and nothing in the body can change the counter. Every other case keeps the check.
 const char* kProven = R"(PROGRAM P
 VAR m : ARRAY [1..3, -1..2] OF DINT; q : ARRAY [0..4, 0..4] OF DINT;
-    i, j : DINT; s, t, u : DINT; n : DINT := 3; END_VAR
+    i, j : DINT; s, t, u, w, x : DINT; n : DINT := 3; v : ARRAY [-2..5] OF INT; END_VAR
+FOR i := -2 TO 5 DO v[i] := DINT_TO_INT(i * 3); END_FOR;
+w := 0;
+FOR i := 5 TO -2 BY -1 DO w := w * 2 + INT_TO_DINT(v[i]); END_FOR;
 FOR i := 1 TO 3 DO FOR j := -1 TO 2 DO m[i, j] := i * 10 + j; END_FOR; END_FOR;
 FOR i := 0 TO 4 DO FOR j := 0 TO 4 DO q[i, j] := i * 5 + j; END_FOR; END_FOR;
 s := 0;
@@ -444,6 +447,8 @@ t := 0;
 FOR i := 1 TO 4 DO FOR j := 0 TO i DO t := t + q[i, j] * (i - j) + q[j, i]; END_FOR; END_FOR;
 u := 0;
 FOR i := 0 TO 2 DO FOR j := 0 TO 2 DO IF q[i, j] > 3 THEN u := u + q[i, j]; ELSE u := u - 1; END_IF; END_FOR; END_FOR;
+x := 0;
+FOR j := 0 TO 4 DO x := x * 3 + q[2, j]; END_FOR;
 END_PROGRAM
 )";
 
@@ -455,9 +460,18 @@ TEST(VmFastPaths, ForCountersInRangeNeedNoIndexCheck) {
   EXPECT_EQ(std::string::npos, dis.find("STXX4 ")) << dis;
   EXPECT_NE(std::string::npos, dis.find("LDXXN4")) << dis;
   EXPECT_NE(std::string::npos, dis.find("STXXN4")) << dis;
+  EXPECT_NE(std::string::npos, dis.find("STXN2")) << dis;   // v[i] :=
+  EXPECT_NE(std::string::npos, dis.find("LDXN2")) << dis;   // v[i]
+  EXPECT_NE(std::string::npos, dis.find("LDXSN4")) << dis;  // q[2, j]
+  EXPECT_EQ(std::string::npos, dis.find("LDX2 ")) << dis;
   ASSERT_TRUE(p.scan()) << p.m->trap().message;
   // The same sums, computed here from the definitions.
-  int64_t s = 0, t = 0, u = 0;
+  int64_t s = 0, t = 0, u = 0, w = 0, x = 0;
+  for (int64_t i = 5; i >= -2; --i) w = w * 2 + i * 3;
+  for (int64_t j = 0; j <= 4; ++j) x = x * 3 + 2 * 5 + j;
+  EXPECT_EQ(w, p.get("P.w"));
+  EXPECT_EQ(x, p.get("P.x"));
+  EXPECT_EQ(-6, p.get("P.v[-2]"));
   auto m = [](int64_t i, int64_t j) { return i * 10 + j; };
   auto q = [](int64_t i, int64_t j) { return i * 5 + j; };
   for (int64_t i = 3; i >= 1; --i)
@@ -486,6 +500,7 @@ TEST(VmFastPaths, IndexChecksStayWhereTheCounterIsNotProven) {
   const Case cases[] = {
       {"the proven case, for contrast", "FOR i := 0 TO 4 DO s := s + q[i, i]; END_FOR;", true, ""},
       {"a bound outside the dimension", "FOR i := 0 TO 5 DO s := s + q[i, i]; END_FOR;", false, "index 5 outside 0..4"},
+      {"a bound outside a rank-1 array", "FOR i := -1 TO 4 DO s := s + v[i] + q[i, i]; END_FOR;", false, "index -1 outside 0..4"},
       {"a bound that is a variable", "FOR i := 0 TO n DO s := s + q[i, i]; END_FOR;", false, "index 5 outside 0..4"},
       {"a counter bounded by a variable", "FOR i := 0 TO n DO FOR j := 0 TO i DO s := s + q[j, j]; END_FOR; END_FOR;", false,
        "index 5 outside 0..4"},
@@ -504,13 +519,16 @@ VAR_INPUT x : DINT; END_VAR
 Twice := 2 * x;
 END_FUNCTION
 PROGRAM P
-VAR q : ARRAY [0..4, 0..4] OF DINT; i, j, s : DINT; n : DINT := 9; f : R_TRIG; p : POINTER TO DINT; END_VAR
+VAR q : ARRAY [0..4, 0..4] OF DINT; v : ARRAY [0..4] OF DINT; i, j, s : DINT; n : DINT := 9; f : R_TRIG;
+    p : POINTER TO DINT; END_VAR
 )") + c.body + "\nEND_PROGRAM\n";
     Prog prog(src);
     ASSERT_TRUE(prog.ok()) << c.what;
     std::string dis = prog.disasm();
     EXPECT_EQ(c.proven, dis.find("LDXXN4") != std::string::npos) << c.what << "\n" << dis;
     EXPECT_EQ(c.proven, dis.find("LDXX4 ") == std::string::npos) << c.what << "\n" << dis;
+    for (const char* op : {" LDXN4", " STXN4", " LDXSN4", " STXSN4"})  // no unchecked rank-1 access either
+      EXPECT_EQ(std::string::npos, dis.find(op)) << c.what << ": " << op << "\n" << dis;
     bool ok = prog.scan();
     if (*c.trap) {
       ASSERT_FALSE(ok) << c.what;
