@@ -747,10 +747,13 @@ void Compiler::for_stmt(const ForStmt& s) {
         *hi = r->hi;
         return true;
       };
+      // The first pass starts at FROM even when the range is empty, should the test on
+      // entry be gone (mutation analysis removes and negates conditional jumps): hence
+      // FROM's whole range, not only TO's side of it.
       int64_t flo, fhi, tlo, thi;
       if (bounds(from, &flo, &fhi) && bounds(to, &tlo, &thi) &&
           keeps_counter(s.body, canon(static_cast<const NameExpr&>(*s.var).name.text)))
-        counters_.push_back({iv, down ? tlo : flo, down ? fhi : thi});
+        counters_.push_back({iv, down ? std::min(tlo, flo) : flo, down ? fhi : std::max(thi, fhi)});
     }
     stmts(s.body);
     counters_.resize(outer);

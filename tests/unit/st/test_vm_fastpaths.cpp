@@ -510,6 +510,13 @@ TEST(VmFastPaths, IndexChecksStayWhereTheCounterIsNotProven) {
        "index 6 outside 0..4"},
       {"a call of a function block", "FOR i := 0 TO 4 DO f(CLK := TRUE); s := s + q[i, i]; END_FOR;", false, ""},
       {"a call of a function", "FOR i := 0 TO 4 DO s := s + Twice(i) + q[i, i]; END_FOR;", false, ""},
+      {"an empty range past the array", "FOR i := 5 TO 4 DO s := s + q[i, i]; END_FOR;", false, ""},
+      {"a range whose start may pass the array", "FOR j := 0 TO 4 DO FOR i := j + 0 TO 4 DO s := s + q[i, i]; END_FOR; END_FOR;",
+       false, ""},
+      {"a start from a counter that may pass the end",
+       "FOR j := 0 TO 6 DO FOR i := j TO 4 DO s := s + q[i, i]; END_FOR; END_FOR;", false, ""},
+      {"a start from a counter that stays inside", "FOR j := 0 TO 4 DO FOR i := j TO 4 DO s := s + q[i, i]; END_FOR; END_FOR;",
+       true, ""},
       {"a write through a pointer", "p := ADR(i); FOR i := 0 TO 4 DO IF i = 1 THEN p^ := 7; END_IF; s := s + q[i, i]; END_FOR;",
        false, "index 7 outside 0..4"},
   };
