@@ -368,7 +368,15 @@ class CsvReader final : public TraceReader {
         // Nanoseconds, as traces wrote time columns before the literals: read exactly.
         int64_t ns = 0;
         auto [end, ec] = std::from_chars(cell.text.data(), cell.text.data() + cell.text.size(), ns);
-        if (ec != std::errc() || end != cell.text.data() + cell.text.size()) ns = static_cast<int64_t>((*values)[c]);
+        if (ec != std::errc() || end != cell.text.data() + cell.text.size()) {
+          double v = std::nearbyint((*values)[c]);
+          if (!(v > -9.2e18 && v < 9.2e18)) {
+            *err = where(name_, line_no, cell.col) + "'" + std::string(cell.text) + "' in column " + columns_[c].name +
+                   " is outside what a TIME can hold (nanoseconds within +-9.2e18)";
+            return false;
+          }
+          ns = static_cast<int64_t>(v);
+        }
         time_values_[c] = ns;
       }
     }

@@ -121,6 +121,15 @@ TEST(TraceReaderCsv, MalformedTimeLiteralsAreErrorsAtTheirPlace) {
   EXPECT_EQ(err, "t.csv:2:3: 'INT#5' in column x is not a number or a TIME, DATE, TOD or DT literal");
   EXPECT_FALSE(csv("time,x\n0,T#1s T#2s\n", &err));
   EXPECT_EQ(err, "t.csv:2:8: 'T#1s T#2s' in column x is not a number or a TIME, DATE, TOD or DT literal: unexpected text after the literal");
+  // A plain number in a TIME column is nanoseconds; one past what int64 holds is an error
+  // at its place, read in the second pass, not a wrapped time.
+  auto r = csv("time,d\n0,T#1s\n0.1,1e21\n", &err);
+  ASSERT_TRUE(r) << err;
+  int64_t t = 0;
+  std::vector<double> v;
+  ASSERT_TRUE(r->next(&t, &v, &err)) << err;
+  EXPECT_FALSE(r->next(&t, &v, &err));
+  EXPECT_EQ(err, "t.csv:3:5: '1e21' in column d is outside what a TIME can hold (nanoseconds within +-9.2e18)");
 }
 
 TEST(TraceReaderCsv, ReadsTimeKindsAndValues) {
