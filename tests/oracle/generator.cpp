@@ -495,8 +495,10 @@ std::string Gen::stmt(const Scope& s, int depth) {
       Scope args = s;
       // Calls that may read it: its own methods, and indirectly THIS^ methods (which read
       // an inner instance), interface calls and FUNCTIONs taking the interface.
-      std::erase_if(args.calls, [&](const Callable& c) {
-        return c.prefix.rfind(inst + ".", 0) == 0 || c.prefix.rfind("THIS^.", 0) == 0 || c.prefix.rfind("itf.", 0) == 0 ||
+      // (A named copy: clang 14 cannot capture a structured binding.)
+      const std::string own = inst + ".";
+      std::erase_if(args.calls, [&own](const Callable& c) {
+        return c.prefix.rfind(own, 0) == 0 || c.prefix.rfind("THIS^.", 0) == 0 || c.prefix.rfind("itf.", 0) == 0 ||
                c.itf_param;
       });
       std::string t = inst + "(";

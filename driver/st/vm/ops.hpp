@@ -67,7 +67,8 @@ inline T wmod(T a, T b) {
 }
 template <class T>
 inline T wabs(T a) {
-  if constexpr (std::is_floating_point_v<T>) return sizeof(T) == 4 ? __builtin_fabsf(a) : __builtin_fabs(a);
+  if constexpr (std::is_same_v<T, float>) return __builtin_fabsf(a);
+  else if constexpr (std::is_floating_point_v<T>) return __builtin_fabs(a);
   else if constexpr (std::is_signed_v<T>) return a < 0 ? wneg(a) : a;
   else return a;
 }

@@ -46,7 +46,6 @@ void same_in_both_tiers(const std::string& src, int scans, const std::function<v
   a.set_budget(budget);
   n.set_budget(budget);
   const auto& inst = b->app->programs.at(0);
-  int traps = 0;
   for (int s = 0; s < scans; ++s) {
     inputs(a, s);
     inputs(n, s);
@@ -55,7 +54,6 @@ void same_in_both_tiers(const std::string& src, int scans, const std::function<v
     bool ra = a.call(inst.pou->entry, inst.addr);
     bool rn = n.call(inst.pou->entry, inst.addr);
     ASSERT_EQ(ra, rn) << "scan " << s;
-    traps += ra ? 0 : 1;
     EXPECT_EQ(describe_trap(*b->app, a.trap()), describe_trap(*b->app, n.trap())) << "scan " << s;
     ASSERT_TRUE(same_memory(*b->app, a, n)) << "memory differs after scan " << s;
     ASSERT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
