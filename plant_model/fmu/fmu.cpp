@@ -130,6 +130,8 @@ void install_crash_guard() {
     sigaction(kWatchdogSignal, &wa, nullptr);
     g_guarded_thread = pthread_self();
     std::thread(watchdog_loop).detach();
+    std::atexit(FmuInstance::on_process_exit);
+    std::at_quick_exit(FmuInstance::on_process_exit);
   });
 }
 
@@ -435,6 +437,18 @@ void FmuInstance::crashed() {
     fail(current_call_, fmt::format("did not return within {} (the FMU hangs; call_timeout in the plant file sets the limit)",
                                     common::format_duration(call_timeout_ns_)));
   fail(current_call_, fmt::format("crashed inside the FMU ({}, signal {})", strsignal(sig), sig));
+}
+
+void FmuInstance::on_process_exit() {
+  const FmuInstance* in = t_current;
+  if (!t_guard || !in) return;  // an ordinary exit, not one from inside an FMU call
+  std::string msg = fmt::format("plcfi: {}: {} ended the process (exit() inside the FMU); an FMU must return a status",
+                                in->label(), in->current_call_);
+  if (!in->last_message_.empty()) msg += fmt::format(" (the FMU logged: {})", in->last_message_);
+  std::fflush(stdout);
+  std::fprintf(stderr, "%s\n", msg.c_str());
+  std::fflush(stderr);
+  std::_Exit(2);
 }
 
 void FmuInstance::fail(std::string_view call, const std::string& what) {

@@ -74,7 +74,9 @@ class FmuArchive {
 // anything else throws FmuError (fmi2Discard from DoStep is reported with the FMU's
 // explanation: the end of its simulation, or a step it rejected). A crash inside the FMU
 // (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT) during a call is caught and reported as an
-// FmuError too; the instance is dead afterwards and is never called again.
+// FmuError too; the instance is dead afterwards and is never called again. An FMU that
+// ends the process (exit, quick_exit) during a call makes plcfi print the FMU and the call
+// and exit with status 2, whatever status the FMU gave.
 class FmuInstance {
  public:
   // fmi2Instantiate (co-simulation, not visible, logging off).
@@ -115,6 +117,11 @@ class FmuInstance {
   const std::string& last_message() const { return last_message_; }
   // What messages name this FMU by: "FMU tank.fmu".
   std::string label() const;
+
+  // Registered with atexit and at_quick_exit by the crash guard (not for callers): the
+  // process ending inside a guarded call (the FMU called exit) is reported with the FMU
+  // and the call, and plcfi exits with status 2 instead.
+  static void on_process_exit();
 
  private:
   void setup(double stop_time);

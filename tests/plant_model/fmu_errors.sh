@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # An FMU that cannot be used is a precise error and exit 2, never a crash or a hang: broken
 # archives and descriptions, a missing binary or symbol, a wrong FMI version, and failures
-# during the run (fmi2Error, a crash inside the FMU, the end of its simulation, a stop time
-# it needs), in sim and in a campaign. Plant-file mistakes point at their line and column.
+# during the run (fmi2Error, a crash inside the FMU, exit() or abort() inside it, the end
+# of its simulation, a stop time it needs), in sim and in a campaign. Plant-file mistakes point at their line and column.
 # usage: fmu_errors.sh PLCFI SOURCE_DIR FMU_DIR
 set -euo pipefail
 plcfi=$1
@@ -47,6 +47,12 @@ plant probe.fmu "parameters: {CrashAt: 0.5}"
 sim "fmi2DoStep crashed inside the FMU (Segmentation fault, signal 11)"
 plant probe.fmu $'call_timeout: 500ms\nparameters: {HangAt: 0.5}'
 sim "fmi2DoStep did not return within 500ms (the FMU hangs; call_timeout in the plant file sets the limit)"
+# An FMU that ends the process inside a call: named with the call, exit 2 (never the
+# FMU's own status 0).
+plant probe.fmu "parameters: {ExitAt: 0.5}"
+sim "plcfi: FMU $fmus/probe.fmu: fmi2DoStep ended the process (exit() inside the FMU); an FMU must return a status"
+plant probe.fmu "parameters: {AbortAt: 0.5}"
+sim "fmi2DoStep crashed inside the FMU (Aborted, signal 6)"
 plant probe.fmu "parameters: {EndAt: 2.5}"
 sim "returned fmi2Discard: the FMU ended its simulation at t = 2.5 s (its DefaultExperiment stopTime is 10 s)"
 plant probe.fmu "parameters: {NeedStopTime: true}"
@@ -54,7 +60,7 @@ sim "probe needs a stop time"
 plant probe.fmu $'stop_time: 2s\nparameters: {NeedStopTime: true}'
 sim "goes past the stop time 2"
 plant probe.fmu "parameters: {Speed: 1}"
-sim "$work/p.yaml:3:21: the FMU has no variable 'Speed' (its parameters: TogglePeriod, FailAt, CrashAt, EndAt, NeedStopTime, InternalStep, HangAt)"
+sim "$work/p.yaml:3:21: the FMU has no variable 'Speed' (its parameters: TogglePeriod, FailAt, CrashAt, EndAt, NeedStopTime, InternalStep, HangAt, ExitAt, AbortAt)"
 plant probe.fmu "stop_time: soon"
 sim "$work/p.yaml:3:12: stop_time: expected a duration, got 'soon'"
 
@@ -69,4 +75,8 @@ sed -e "s|^plant: stamping|plant: $work/p.yaml|" -e "s|\.\./\.\./\.\./st_program
     "$src/faults/campaigns/stamping/campaign.yaml" > "$work/campaign.yaml"
 plant probe.fmu "parameters: {FailAt: 0.2}"
 expect "fmi2DoStep(t = 0.2 s, h = 0.01 s) returned fmi2Error" "$plcfi" campaign "$work/campaign.yaml" --out "$work/c" --quiet
+plant probe.fmu "parameters: {ExitAt: 0.2}"
+expect "fmi2DoStep ended the process (exit() inside the FMU)" "$plcfi" campaign "$work/campaign.yaml" --out "$work/c2" --quiet
+plant probe.fmu "parameters: {ExitAt: 0.2}"
+expect "fmi2DoStep ended the process (exit() inside the FMU)" "$plcfi" campaign "$work/campaign.yaml" --out "$work/c3" --quiet --jobs 2
 echo "FMU errors OK"

@@ -12,13 +12,17 @@
      Integer  1 Steps         output: fmi2DoStep calls that advanced the time
      Real     1 Ramp          output: t
              10 TogglePeriod (s)   11 FailAt (s)   12 CrashAt (s)   13 EndAt (s)
-             14 InternalStep (s)   15 HangAt (s)                   (fixed parameters)
+             14 InternalStep (s)   15 HangAt (s)   16 ExitAt (s)   17 AbortAt (s)
+                                                                   (fixed parameters)
 
    Failures (a negative time means never; "a step passes T" means it would end after T):
    - FailAt: a step that passes FailAt returns fmi2Error, logs "step failed at t = ..."
      with the step's start, and the time stays there;
    - CrashAt: a step that passes CrashAt writes through a NULL pointer (SIGSEGV);
    - HangAt: a step that passes HangAt never returns (an endless loop);
+   - ExitAt: a step that passes ExitAt ends the process with exit(0), as an FMU written
+     for a stand-alone tool may;
+   - AbortAt: a step that passes AbortAt calls abort();
    - EndAt: a step that passes EndAt advances to EndAt only and returns fmi2Discard; then
      fmi2GetBooleanStatus(fmi2Terminated) is fmi2True and
      fmi2GetRealStatus(fmi2LastSuccessfulTime) is EndAt;
@@ -30,6 +34,7 @@
    like an FMU with a coarse internal solver. */
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 
 #include "fmu_support.h"
 
@@ -42,6 +47,8 @@ typedef struct {
   double crash_at;
   double end_at;
   double hang_at;
+  double exit_at;
+  double abort_at;
   double internal_step;
   int need_stop_time;
   /* outputs */
@@ -65,6 +72,8 @@ static const FmuVariable kVariables[] = {
     VAR("NeedStopTime", FMU_BOOLEAN, 10, FMU_PARAMETER, need_stop_time, FMU_ANY),
     VAR("InternalStep", FMU_REAL, 14, FMU_PARAMETER, internal_step, FMU_NON_NEGATIVE),
     VAR("HangAt", FMU_REAL, 15, FMU_PARAMETER, hang_at, FMU_ANY),
+    VAR("ExitAt", FMU_REAL, 16, FMU_PARAMETER, exit_at, FMU_ANY),
+    VAR("AbortAt", FMU_REAL, 17, FMU_PARAMETER, abort_at, FMU_ANY),
 };
 
 static void defaults(Fmu* f) {
@@ -75,6 +84,8 @@ static void defaults(Fmu* f) {
   m->crash_at = -1.0;
   m->end_at = -1.0;
   m->hang_at = -1.0;
+  m->exit_at = -1.0;
+  m->abort_at = -1.0;
   m->internal_step = 0.0;
   m->need_stop_time = 0;
 }
@@ -121,7 +132,7 @@ static void hang(void) {
   }
 }
 
-typedef enum { NONE, CRASH, HANG, FAIL, STOP, END } Event;
+typedef enum { NONE, CRASH, HANG, EXIT, ABORT, FAIL, STOP, END } Event;
 
 static fmi2Status do_step(Fmu* f, double h) {
   Probe* m = f->data;
@@ -139,6 +150,8 @@ static fmi2Status do_step(Fmu* f, double h) {
   } candidates[] = {
       {CRASH, m->crash_at >= 0.0, m->crash_at},
       {HANG, m->hang_at >= 0.0, m->hang_at},
+      {EXIT, m->exit_at >= 0.0, m->exit_at},
+      {ABORT, m->abort_at >= 0.0, m->abort_at},
       {FAIL, m->fail_at >= 0.0, m->fail_at},
       {STOP, m->need_stop_time && f->stop_time_defined, f->stop_time},
       {END, m->end_at >= 0.0, m->end_at},
@@ -157,6 +170,10 @@ static fmi2Status do_step(Fmu* f, double h) {
     case HANG:
       hang();
       return fmi2Fatal; /* not reached */
+    case EXIT:
+      exit(0);
+    case ABORT:
+      abort();
     case FAIL:
       fmu_log(f, fmi2Error, "step failed at t = %g (FailAt %g)", t0, m->fail_at);
       return fmi2Error;

@@ -327,6 +327,21 @@ TEST_F(FmuPlantTest, FailuresInTheRunNameTheCallAndTheTime) {
   EXPECT_NE(e.find("needs a stop time"), std::string::npos) << e;
 }
 
+// An FMU that calls exit(0) inside a call ends plcfi with status 2 and a message naming
+// the FMU and the call, never with the FMU's own status.
+TEST_F(FmuPlantTest, ExitInsideACallEndsWithStatusTwo) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(
+      {
+        std::string err;
+        auto p = open(probe("parameters: {ExitAt: 0.2}\n"), &err);
+        std::vector<double> v(4, 0.0);
+        for (int i = 0; p && i < 100; ++i) p->step(0.01, v.data(), v.data());
+        std::exit(0);  // reached only if the FMU did not exit
+      },
+      ::testing::ExitedWithCode(2), "probe.fmu: fmi2DoStep ended the process \\(exit\\(\\) inside the FMU\\)");
+}
+
 TEST_F(FmuPlantTest, AnStPlantRunsAtItsStep) {
   write("counter.st",
         "PROGRAM Counter\nVAR_INPUT Run : BOOL; END_VAR\nVAR_OUTPUT Ticks : INT; Level : REAL; Up : BOOL; END_VAR\n"
