@@ -66,7 +66,7 @@ std::string stamping_model_description(const Plant& plant, int64_t step_ns) {
       "exported by plcfi plant export-fmu\"\n"
       "  generationTool=\"plcfi\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">\n"
       "  <CoSimulation modelIdentifier=\"{id}\" canHandleVariableCommunicationStepSize=\"true\" "
-      "canGetAndSetFMUstate=\"false\" canSerializeFMUstate=\"false\"/>\n"
+      "canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"false\" providesDirectionalDerivative=\"false\"/>\n"
       "  <DefaultExperiment startTime=\"0\" stepSize=\"{step}\"/>\n"
       "  <ModelVariables>\n{vars}  </ModelVariables>\n"
       "  <ModelStructure>\n    <Outputs>\n{outs}    </Outputs>\n    <InitialUnknowns>\n{outs}    </InitialUnknowns>\n"

@@ -80,6 +80,27 @@ typedef fmi2Status fmi2GetStatusTYPE(fmi2Component c, fmi2StatusKind kind, fmi2S
 typedef fmi2Status fmi2GetRealStatusTYPE(fmi2Component c, fmi2StatusKind kind, fmi2Real* value);
 typedef fmi2Status fmi2GetIntegerStatusTYPE(fmi2Component c, fmi2StatusKind kind, fmi2Integer* value);
 typedef fmi2Status fmi2GetBooleanStatusTYPE(fmi2Component c, fmi2StatusKind kind, fmi2Boolean* value);
+typedef fmi2Status fmi2GetStringStatusTYPE(fmi2Component c, fmi2StatusKind kind, fmi2String* value);
+typedef fmi2Status fmi2GetStringTYPE(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String value[]);
+typedef fmi2Status fmi2SetStringTYPE(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                     const fmi2String value[]);
+/* FMU state (canGetAndSetFMUstate, canSerializeFMUstate) and derivatives
+   (providesDirectionalDerivative, canInterpolateInputs, maxOutputDerivativeOrder): every
+   FMU defines them; one that does not claim the capability returns fmi2Error. */
+typedef fmi2Status fmi2GetFMUstateTYPE(fmi2Component c, fmi2FMUstate* state);
+typedef fmi2Status fmi2SetFMUstateTYPE(fmi2Component c, fmi2FMUstate state);
+typedef fmi2Status fmi2FreeFMUstateTYPE(fmi2Component c, fmi2FMUstate* state);
+typedef fmi2Status fmi2SerializedFMUstateSizeTYPE(fmi2Component c, fmi2FMUstate state, size_t* size);
+typedef fmi2Status fmi2SerializeFMUstateTYPE(fmi2Component c, fmi2FMUstate state, fmi2Byte serialized[], size_t size);
+typedef fmi2Status fmi2DeSerializeFMUstateTYPE(fmi2Component c, const fmi2Byte serialized[], size_t size,
+                                               fmi2FMUstate* state);
+typedef fmi2Status fmi2GetDirectionalDerivativeTYPE(fmi2Component c, const fmi2ValueReference unknown_refs[],
+                                                    size_t n_unknown, const fmi2ValueReference known_refs[],
+                                                    size_t n_known, const fmi2Real dv_known[], fmi2Real dv_unknown[]);
+typedef fmi2Status fmi2SetRealInputDerivativesTYPE(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                                   const fmi2Integer order[], const fmi2Real value[]);
+typedef fmi2Status fmi2GetRealOutputDerivativesTYPE(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+                                                    const fmi2Integer order[], fmi2Real value[]);
 
 #ifdef __cplusplus
 }

@@ -63,6 +63,12 @@ fmi2Status fail(Instance* in, const char* fmt, fmi2ValueReference vr) {
   return fmi2Error;
 }
 
+// A function of a capability the description does not claim.
+fmi2Status unsupported(fmi2Component c, const char* function, const char* why) {
+  log(as(c), fmi2Error, "%s: not supported (%s)", function, why);
+  return fmi2Error;
+}
+
 void restart(Instance* in) {
   in->plant.reset(static_cast<uint64_t>(in->seed));
   std::fill(in->act.begin(), in->act.end(), 0.0);
@@ -249,5 +255,73 @@ FMI2_EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component, fmi2StatusKind kind, 
   return fmi2OK;
 }
 FMI2_EXPORT fmi2Status fmi2GetStringStatus(fmi2Component, fmi2StatusKind, fmi2String*) { return fmi2Discard; }
+
+// ---- FMU state: a copy of the instance (the plant's state is a few hundred bytes and a
+// delivery schedule), so a master can go back to an earlier communication point.
+// Serialization and derivatives are not offered; the description says so and the
+// functions refuse with a log message, as the standard asks of every FMU.
+
+FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state) {
+  Instance* in = as(c);
+  if (!in || !state) return fmi2Error;
+  if (*state) {
+    *static_cast<Instance*>(*state) = *in;  // the importer hands an earlier state back to be reused
+    return fmi2OK;
+  }
+  auto* copy = new (std::nothrow) Instance(*in);
+  if (!copy) {
+    log(in, fmi2Error, "fmi2GetFMUstate: out of memory");
+    return fmi2Error;
+  }
+  *state = copy;
+  return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
+  Instance* in = as(c);
+  if (!in) return fmi2Error;
+  if (!state) {
+    log(in, fmi2Error, "fmi2SetFMUstate: no state (NULL)");
+    return fmi2Error;
+  }
+  const auto* from = static_cast<const Instance*>(state);
+  // The state of the instance, not its identity: name and callbacks stay.
+  in->plant = from->plant;
+  in->act = from->act;
+  in->sen = from->sen;
+  in->seed = from->seed;
+  in->time = from->time;
+  in->state = from->state;
+  return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* state) {
+  if (!c || !state) return fmi2Error;
+  delete static_cast<Instance*>(*state);
+  *state = nullptr;
+  return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate, size_t*) {
+  return unsupported(c, "fmi2SerializedFMUstateSize", "canSerializeFMUstate is false");
+}
+FMI2_EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate, fmi2Byte[], size_t) {
+  return unsupported(c, "fmi2SerializeFMUstate", "canSerializeFMUstate is false");
+}
+FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte[], size_t, fmi2FMUstate*) {
+  return unsupported(c, "fmi2DeSerializeFMUstate", "canSerializeFMUstate is false");
+}
+FMI2_EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference[], size_t,
+                                                    const fmi2ValueReference[], size_t, const fmi2Real[], fmi2Real[]) {
+  return unsupported(c, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative is false");
+}
+FMI2_EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference[], size_t,
+                                                   const fmi2Integer[], const fmi2Real[]) {
+  return unsupported(c, "fmi2SetRealInputDerivatives", "canInterpolateInputs is false");
+}
+FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference[], size_t,
+                                                    const fmi2Integer[], fmi2Real[]) {
+  return unsupported(c, "fmi2GetRealOutputDerivatives", "maxOutputDerivativeOrder is 0");
+}
 
 }  // extern "C"
