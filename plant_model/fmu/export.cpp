@@ -32,6 +32,40 @@ std::string xml_escape(const std::string& s) {
 
 }  // namespace
 
+void write_fmu_archive(const std::string& out, const std::vector<ArchiveEntry>& entries) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const std::string tmp = out + ".tmp";
+  fs::remove(tmp, ec);
+  int zerr = 0;
+  zip_t* z = zip_open(tmp.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &zerr);
+  if (!z) {
+    zip_error_t e;
+    zip_error_init_with_code(&e, zerr);
+    std::string what = zip_error_strerror(&e);
+    zip_error_fini(&e);
+    throw common::InputError(fmt::format("{}: cannot write: {}", out, what));
+  }
+  auto fail = [&](const std::string& what) {
+    std::string msg = fmt::format("{}: cannot write: {}: {}", out, what, zip_error_strerror(zip_get_error(z)));
+    zip_discard(z);
+    fs::remove(tmp, ec);
+    throw common::InputError(msg);
+  };
+  for (const auto& e : entries) {
+    // zip_source_buffer keeps a pointer: `entries` outlives zip_close below.
+    zip_source_t* src = e.from.empty() ? zip_source_buffer(z, e.data.data(), e.data.size(), 0)
+                                       : zip_source_file(z, e.from.c_str(), 0, -1);
+    if (!src || zip_file_add(z, e.name.c_str(), src, ZIP_FL_ENC_UTF_8) < 0) {
+      if (src) zip_source_free(src);
+      fail(e.name);
+    }
+  }
+  if (zip_close(z) != 0) fail("closing the archive");
+  fs::rename(tmp, out, ec);
+  if (ec) throw common::InputError(fmt::format("{}: cannot write: {}", out, ec.message()));
+}
+
 std::string stamping_model_description(const Plant& plant, int64_t step_ns) {
   const auto& sigs = plant.signals();
   std::string vars, outputs;
@@ -82,39 +116,8 @@ void export_stamping_fmu(const Plant& plant, const ExportOptions& opt) {
   if (!fs::is_regular_file(opt.library, ec))
     throw common::InputError(fmt::format("{}: the FMU binary is missing (it is built with plcfi: target plcfi_stamping_fmu)",
                                          opt.library));
-  const std::string md = stamping_model_description(plant, opt.step_ns);
-  const std::string tmp = opt.out + ".tmp";
-  fs::remove(tmp, ec);
-  int zerr = 0;
-  zip_t* z = zip_open(tmp.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &zerr);
-  if (!z) {
-    zip_error_t e;
-    zip_error_init_with_code(&e, zerr);
-    std::string what = zip_error_strerror(&e);
-    zip_error_fini(&e);
-    throw common::InputError(fmt::format("{}: cannot write: {}", opt.out, what));
-  }
-  auto fail = [&](const std::string& what) {
-    std::string msg = fmt::format("{}: cannot write: {}: {}", opt.out, what, zip_error_strerror(zip_get_error(z)));
-    zip_discard(z);
-    fs::remove(tmp, ec);
-    throw common::InputError(msg);
-  };
-  // zip_source_buffer keeps a pointer: `md` outlives zip_close below.
-  zip_source_t* src = zip_source_buffer(z, md.data(), md.size(), 0);
-  if (!src || zip_file_add(z, "modelDescription.xml", src, ZIP_FL_ENC_UTF_8) < 0) {
-    if (src) zip_source_free(src);
-    fail("modelDescription.xml");
-  }
-  const std::string so = fmt::format("binaries/linux64/{}.so", kStampingFmuIdentifier);
-  zip_source_t* bin = zip_source_file(z, opt.library.c_str(), 0, -1);
-  if (!bin || zip_file_add(z, so.c_str(), bin, ZIP_FL_ENC_UTF_8) < 0) {
-    if (bin) zip_source_free(bin);
-    fail(so);
-  }
-  if (zip_close(z) != 0) fail("closing the archive");
-  fs::rename(tmp, opt.out, ec);
-  if (ec) throw common::InputError(fmt::format("{}: cannot write: {}", opt.out, ec.message()));
+  write_fmu_archive(opt.out, {{"modelDescription.xml", stamping_model_description(plant, opt.step_ns), ""},
+                              {fmt::format("binaries/linux64/{}.so", kStampingFmuIdentifier), "", opt.library}});
 
   if (opt.plant_file.empty()) return;
   std::string stat_names;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "plant_model/plant.hpp"
 
@@ -15,6 +16,16 @@ struct ExportOptions {
   std::string plant_file;  // optional: the plant file to write beside it
   int64_t step_ns = 10'000'000;  // DefaultExperiment stepSize and the plant file's step
 };
+
+// One file of an FMU archive: its text, or the file on disk to copy (`from`).
+struct ArchiveEntry {
+  std::string name;  // path in the archive: modelDescription.xml, binaries/linux64/X.so, ...
+  std::string data;
+  std::string from;  // when set, the archive gets this file's bytes instead of data
+};
+// Writes the archive atomically (to OUT.tmp, then renamed). Throws common::InputError
+// naming `out` on failure.
+void write_fmu_archive(const std::string& out, const std::vector<ArchiveEntry>& entries);
 
 // modelDescription.xml of the stamping FMU (signal i = value reference i; actuators are
 // inputs, sensors outputs; BOOL signals Boolean, analog ones Integer; parameter seed).
