@@ -22,14 +22,13 @@ namespace po = boost::program_options;
 
 namespace plcfi::cli {
 
-namespace {
-
-// The folder of the running plcfi executable (the FMU binary is built beside it).
 std::string exe_dir() {
   std::error_code ec;
   auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
   return ec ? std::string(".") : p.parent_path().string();
 }
+
+namespace {
 
 int plant_info(const std::vector<std::string>& args) {
   po::options_description desc("plcfi plant info: the signals of a plant and their image addresses");

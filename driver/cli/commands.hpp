@@ -29,6 +29,10 @@ int cmd_script(const std::vector<std::string>& args);
 int cmd_history(const std::vector<std::string>& args);
 int cmd_plant(const std::vector<std::string>& args);
 int cmd_merge(const std::vector<std::string>& args);
+int cmd_export_fmu(const std::vector<std::string>& args);
+
+// The folder of the running plcfi executable (the FMU binaries are built beside it).
+std::string exe_dir();
 
 // --native: the application's native tier, built (or found in the cache) and reported
 // on stderr as `who: native tier: ...`; nullptr after printing the error.

@@ -36,6 +36,7 @@ const std::vector<Command>& commands() {
       {"script", "run CPTest+ test scripts (.cpt) against a program and a plant model, with ASSERT_COM and link faults", plcfi::cli::cmd_script},
       {"history", "show the run history of test scripts, newest first", plcfi::cli::cmd_history},
       {"plant", "look at a plant's signals (plant info) or export the stamping plant as an FMU (plant export-fmu)", plcfi::cli::cmd_plant},
+      {"export-fmu", "pack the PLC program as an FMI 2.0 co-simulation FMU, with fault parameters on its I/O", plcfi::cli::cmd_export_fmu},
       {"merge", "combine the shard files of campaign --shard or mutate --shard into the journal of one run", plcfi::cli::cmd_merge},
       {"plant-server", "serve a plant model in real time over Modbus TCP (bench rehearsal)", plcfi::cli::cmd_plant_server},
   };

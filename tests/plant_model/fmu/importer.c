@@ -9,6 +9,8 @@
      --bool-out VR     print Boolean output VR after every step (in the order given)
      --state           get the FMU state halfway, finish, set the state back and run the
                        second half again: the outputs must be the same (canGetAndSetFMUstate)
+     --no-state        the FMU does not claim canGetAndSetFMUstate: fmi2GetFMUstate and
+                       fmi2SetFMUstate must refuse with fmi2Error and a log message
    Prints "missing: NAME" for each function the binary lacks (exit 1), the outputs as one
    line of 0/1 per step, and "ok" at the end. Any status other than the one the standard
    asks for is a message and exit 1. */
@@ -108,10 +110,12 @@ int main(int argc, char** argv) {
   if (!(h > 0) || steps < 2) fail("STEP_S must be > 0 and STEPS at least 2");
   Io io;
   memset(&io, 0, sizeof io);
-  int state = 0;
+  int state = 0, no_state = 0;
   for (int i = 6; i < argc; ++i) {
     if (strcmp(argv[i], "--state") == 0) {
       state = 1;
+    } else if (strcmp(argv[i], "--no-state") == 0) {
+      no_state = 1;
     } else if (strcmp(argv[i], "--bool-in") == 0 && i + 1 < argc && io.n_in < MAX_VR) {
       unsigned vr;
       long k;
@@ -191,7 +195,7 @@ int main(int argc, char** argv) {
   struct {
     const char* name;
     fmi2Status status;
-  } refused[7];
+  } refused[9];
   fmi2ValueReference vr0 = 0;
   fmi2Real r = 0;
   fmi2Integer order = 1;
@@ -213,14 +217,23 @@ int main(int argc, char** argv) {
   refused[5].status = F(fmi2GetRealOutputDerivatives)(c, &vr0, 1, &order, &r);
   refused[6].name = "fmi2CancelStep";
   refused[6].status = F(fmi2CancelStep)(c);
-  for (int i = 0; i < 7; ++i)
+  int n_refused = 7;
+  if (no_state) {
+    refused[7].name = "fmi2GetFMUstate";
+    refused[7].status = F(fmi2GetFMUstate)(c, &other);
+    refused[8].name = "fmi2SetFMUstate";
+    refused[8].status = F(fmi2SetFMUstate)(c, other);
+    n_refused = 9;
+    expect(F(fmi2FreeFMUstate)(c, &other), fmi2OK, "fmi2FreeFMUstate (no state)");
+  }
+  for (int i = 0; i < n_refused; ++i)
     if (refused[i].status != fmi2Error) {
       fprintf(stderr, "importer: %s returned %d; an FMU without the capability returns fmi2Error\n", refused[i].name,
               (int)refused[i].status);
       return 1;
     }
-  if (logged < 6) fail("the refusals did not say why in the FMU's log");
-  printf("refused with a log message: serialization, derivatives, cancel\n");
+  if (logged < n_refused - 1) fail("the refusals did not say why in the FMU's log");
+  printf("refused with a log message: serialization, derivatives, cancel%s\n", no_state ? ", FMU state" : "");
   /* The status queries and the empty exchanges of the other types. */
   fmi2Status st;
   fmi2Integer iv;
