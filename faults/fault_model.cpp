@@ -286,6 +286,7 @@ class FaultRule : public rt::OverlayRule {
 
 class ConstantRule final : public FaultRule {
  public:
+  std::unique_ptr<rt::OverlayRule> clone() const override { return std::make_unique<ConstantRule>(*this); }
   ConstantRule(const InjectionContext& c, std::string d, double v) : FaultRule(c, std::move(d)), v_(v) {}
   double transform(double, int64_t) override { return v_; }
 
@@ -295,6 +296,7 @@ class ConstantRule final : public FaultRule {
 
 class AffineRule final : public FaultRule {  // v * gain + offset + rate * t
  public:
+  std::unique_ptr<rt::OverlayRule> clone() const override { return std::make_unique<AffineRule>(*this); }
   AffineRule(const InjectionContext& c, std::string d, double gain, double offset, double rate_per_s)
       : FaultRule(c, std::move(d)), gain_(gain), offset_(offset), rate_(rate_per_s) {}
   double transform(double v, int64_t now) override {
@@ -307,6 +309,7 @@ class AffineRule final : public FaultRule {  // v * gain + offset + rate * t
 
 class InvertRule final : public FaultRule {
  public:
+  std::unique_ptr<rt::OverlayRule> clone() const override { return std::make_unique<InvertRule>(*this); }
   using FaultRule::FaultRule;
   double transform(double v, int64_t) override { return v != 0 ? 0 : 1; }
 };
@@ -315,6 +318,7 @@ class InvertRule final : public FaultRule {
 // on the seed (not on a library's distribution code).
 class NoiseRule final : public FaultRule {
  public:
+  std::unique_ptr<rt::OverlayRule> clone() const override { return std::make_unique<NoiseRule>(*this); }
   NoiseRule(const InjectionContext& c, std::string d, double sigma) : FaultRule(c, std::move(d)), sigma_(sigma), rng_(c.seed) {}
   double transform(double v, int64_t) override {
     double u1 = static_cast<double>((rng_() >> 11) + 1) * 0x1.0p-53;  // (0, 1]
@@ -331,6 +335,7 @@ class NoiseRule final : public FaultRule {
 // The ring holds delay / tick samples (+ margin), allocated here and never grown.
 class DelayRule final : public FaultRule {
  public:
+  std::unique_ptr<rt::OverlayRule> clone() const override { return std::make_unique<DelayRule>(*this); }
   DelayRule(const InjectionContext& c, std::string d, int64_t delay_ns) : FaultRule(c, std::move(d)), delay_(delay_ns) {
     int64_t tick = c.tick_ns > 0 ? c.tick_ns : 1'000'000;
     ring_.resize(static_cast<size_t>(delay_ns / tick) + 4);
@@ -359,6 +364,7 @@ class DelayRule final : public FaultRule {
 // The sensor drops to its pre-fault value part of the time.
 class IntermittentRule final : public FaultRule {
  public:
+  std::unique_ptr<rt::OverlayRule> clone() const override { return std::make_unique<IntermittentRule>(*this); }
   IntermittentRule(const InjectionContext& c, std::string d, const FaultSpec& f)
       : FaultRule(c, std::move(d)), random_(f.random), p_(f.value), span_(f.duration_ns), rng_(c.seed) {}
   double transform(double v, int64_t now) override {

@@ -122,7 +122,7 @@ std::string model_description(const Manifest& m) {
       "  <CoSimulation modelIdentifier=\"{id}\" needsExecutionTool=\"false\" "
       "canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" "
       "canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" "
-      "canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"false\" canSerializeFMUstate=\"false\" "
+      "canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"false\" "
       "providesDirectionalDerivative=\"false\"/>\n"
       "  <LogCategories>\n"
       "    <Category name=\"logStatusWarning\" description=\"the program stopped (a trap): outputs in the safe state\"/>\n"

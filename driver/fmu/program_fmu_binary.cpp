@@ -5,7 +5,8 @@
 // program's own base tick, as `plcfi sim` does: inputs as the master set them, through the
 // input overlay, the tasks, the output overlay; outputs are what reaches the plant.
 // Fault parameters put a fault model of plcfi's on a port from a given time on, as a
-// campaign injects it. Value references: see program_fmu.hpp.
+// campaign injects it. Value references: see program_fmu.hpp. The FMU state can be saved
+// and restored (canGetAndSetFMUstate).
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -608,20 +609,57 @@ FMI2_EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, fmi2StatusKind kind
 }
 FMI2_EXPORT fmi2Status fmi2GetStringStatus(fmi2Component, fmi2StatusKind, fmi2String*) { return fmi2Discard; }
 
-// ---- What the description does not claim: the functions refuse with a log message. The
-// state of a running program (memory, clock, the fault models' histories) is not offered
-// as an FMU state (canGetAndSetFMUstate="false").
+// ---- FMU state: a copy of the scan's state (program memory, clock, image layers, the
+// fault overlays with their rules' state) and of the instance's own, so a master can go
+// back to an earlier communication point. Serialization and derivatives are not offered;
+// the description says so and the functions refuse with a log message.
 
-FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate*) {
-  return unsupported(c, "fmi2GetFMUstate", "canGetAndSetFMUstate is false");
+namespace {
+struct SavedState {
+  rt::Runtime::State runtime;
+  std::vector<uint8_t> in, out;
+  std::vector<PortFault> faults;
+  fmi2Integer seed = 1;
+  State state = State::Instantiated;
+  int64_t time_ns = 0;
+  bool trap_logged = false;
+};
+}  // namespace
+
+FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state) {
+  return guarded(c, "fmi2GetFMUstate", [&](Instance* in) {
+    if (!state) return error(in, "fmi2GetFMUstate: no place for the state (NULL)");
+    auto saved = std::make_unique<SavedState>(SavedState{in->runtime->save_state(), in->backend->in, in->backend->out,
+                                                         in->faults, in->seed, in->state, in->time_ns, in->trap_logged});
+    delete static_cast<SavedState*>(*state);  // an earlier state handed back to be overwritten
+    *state = saved.release();
+    return fmi2OK;
+  });
 }
-FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate) {
-  return unsupported(c, "fmi2SetFMUstate", "canGetAndSetFMUstate is false");
+
+FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
+  return guarded(c, "fmi2SetFMUstate", [&](Instance* in) {
+    if (!state) return error(in, "fmi2SetFMUstate: no state (NULL)");
+    const auto* s = static_cast<const SavedState*>(state);
+    in->runtime->restore_state(s->runtime);
+    in->backend->in = s->in;
+    in->backend->out = s->out;
+    in->faults = s->faults;
+    in->seed = s->seed;
+    in->state = s->state;
+    in->time_ns = s->time_ns;
+    in->trap_logged = s->trap_logged;
+    return fmi2OK;
+  });
 }
+
 FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* state) {
-  if (state && !*state) return fmi2OK;  // nothing to free
-  return unsupported(c, "fmi2FreeFMUstate", "canGetAndSetFMUstate is false");
+  if (!c || !state) return fmi2Error;
+  delete static_cast<SavedState*>(*state);
+  *state = nullptr;
+  return fmi2OK;
 }
+
 FMI2_EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate, size_t*) {
   return unsupported(c, "fmi2SerializedFMUstateSize", "canSerializeFMUstate is false");
 }

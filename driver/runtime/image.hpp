@@ -90,6 +90,9 @@ class OverlayRule {
   virtual std::string describe() const = 0;
   // One past the last byte of the area the rule touches (the runtime copies that far).
   virtual uint32_t extent() const = 0;
+  // A copy with the rule's state as it is now (a delay line's samples, a noise
+  // generator's position): saved runtime states hold copies.
+  virtual std::unique_ptr<OverlayRule> clone() const = 0;
 };
 
 // Forces a location to a fixed value (the classic force table of soft PLCs).
@@ -99,6 +102,7 @@ class ForceRule final : public OverlayRule {
   void apply(uint8_t* dst, const uint8_t*, int64_t) override { ref_.set(dst, value_); }
   std::string describe() const override;
   uint32_t extent() const override { return ref_.offset + ref_.size; }
+  std::unique_ptr<OverlayRule> clone() const override { return std::make_unique<ForceRule>(*this); }
 
  private:
   ImageRef ref_;
@@ -119,6 +123,12 @@ class Overlay {
   }
   uint32_t extent() const { return extent_; }
   bool empty() const { return rules_.empty(); }
+  // A copy of every rule with its state (clone()).
+  Overlay copy() const {
+    Overlay o;
+    for (const auto& r : rules_) o.add(r->clone());
+    return o;
+  }
   const std::vector<std::unique_ptr<OverlayRule>>& rules() const { return rules_; }
 
  private:

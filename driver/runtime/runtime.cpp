@@ -64,6 +64,25 @@ bool Runtime::write_safe_outputs() {
   return !backend_ || backend_->write_final(out_.data(), now_ns_);
 }
 
+Runtime::State Runtime::save_state() const {
+  return State{machine_.save_state(), raw_in_, out_, in_overlay_.copy(), out_overlay_.copy(),
+               now_ns_, scans_, stopped_, trap_at_restart_, stop_reason_};
+}
+
+void Runtime::restore_state(const State& s) {
+  machine_.restore_state(s.machine);
+  machine_.set_now(s.now_ns);
+  raw_in_ = s.raw_in;
+  out_ = s.out;
+  in_overlay_ = s.in_overlay.copy();
+  out_overlay_ = s.out_overlay.copy();
+  now_ns_ = s.now_ns;
+  scans_ = s.scans;
+  stopped_ = s.stopped;
+  trap_at_restart_ = s.trap_at_restart;
+  stop_reason_ = s.stop_reason;
+}
+
 void Runtime::stop(const std::string& reason) {
   stopped_ = true;
   stop_reason_ = reason;

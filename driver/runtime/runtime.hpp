@@ -90,6 +90,23 @@ class Runtime {
   // Stops the program (e.g. a watchdog of the caller); outputs go to the safe state.
   void stop(const std::string& reason);
 
+  // Everything a later scan depends on: the program's memory, the clock and scan count,
+  // both image layers, the overlays with their rules' state, a trap that stopped the
+  // program. Saved and restored between scans (an FMU's fmi2GetFMUstate and
+  // fmi2SetFMUstate); the backend's state is the caller's to keep.
+  struct State {
+    st::Machine::State machine;
+    std::vector<uint8_t> raw_in, out;
+    Overlay in_overlay, out_overlay;
+    int64_t now_ns = 0;
+    uint64_t scans = 0;
+    bool stopped = false, trap_at_restart = false;
+    std::string stop_reason;
+  };
+  State save_state() const;
+  // The state must come from a runtime of the same application.
+  void restore_state(const State& s);
+
  private:
   void restart(uint64_t seed, bool warm);
   // Runs the tasks due at the current tick; false when one trapped (the trap is in machine_).

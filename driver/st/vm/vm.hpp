@@ -122,6 +122,23 @@ class Machine {
   // Backward jumps and loop iterations allowed per call() before a Watchdog trap.
   void set_budget(uint64_t budget) { budget_limit_ = budget; }
 
+  // What a machine needs to go on from where it was: memory, cumulative coverage, the
+  // trap that stopped it, whether it has started (an FMU's saved state).
+  struct State {
+    std::vector<uint8_t> mem;
+    std::vector<uint64_t> covered;
+    Trap trap;
+    bool started = false;
+  };
+  State save_state() const { return State{mem_, covered_, trap_, started_}; }
+  // The state must come from a machine of the same application.
+  void restore_state(const State& s) {
+    mem_ = s.mem;
+    covered_ = s.covered;
+    trap_ = s.trap;
+    started_ = s.started;
+  }
+
   uint8_t* mem() { return mem_.data(); }
   const uint8_t* mem() const { return mem_.data(); }
   size_t mem_size() const { return mem_.size(); }
