@@ -302,26 +302,6 @@ FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* state) {
   return fmi2OK;
 }
 
-FMI2_EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate, size_t*) {
-  return unsupported(c, "fmi2SerializedFMUstateSize", "canSerializeFMUstate is false");
-}
-FMI2_EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate, fmi2Byte[], size_t) {
-  return unsupported(c, "fmi2SerializeFMUstate", "canSerializeFMUstate is false");
-}
-FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte[], size_t, fmi2FMUstate*) {
-  return unsupported(c, "fmi2DeSerializeFMUstate", "canSerializeFMUstate is false");
-}
-FMI2_EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference[], size_t,
-                                                    const fmi2ValueReference[], size_t, const fmi2Real[], fmi2Real[]) {
-  return unsupported(c, "fmi2GetDirectionalDerivative", "providesDirectionalDerivative is false");
-}
-FMI2_EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference[], size_t,
-                                                   const fmi2Integer[], const fmi2Real[]) {
-  return unsupported(c, "fmi2SetRealInputDerivatives", "canInterpolateInputs is false");
-}
-FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference[], size_t,
-                                                    const fmi2Integer[], fmi2Real[]) {
-  return unsupported(c, "fmi2GetRealOutputDerivatives", "maxOutputDerivativeOrder is 0");
-}
+#include "plant_model/fmu/export/fmi2_refusals.inc"
 
 }  // extern "C"
