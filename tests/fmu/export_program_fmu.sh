@@ -10,7 +10,8 @@
 #  3. the fault parameters reproduce the published failing case (F3: StampLowered stuck
 #     during the reference stroke goes unnoticed by stamping.st; stamping_fixed.st raises
 #     the alarm), and a bad fault parameter is refused at initialization;
-#  4. programs FMI cannot carry are refused at export with the variable's file:line:col.
+#  4. programs FMI cannot carry are refused at export with the variable's file:line:col;
+#  and every description passes fmi2_md_check.py (the standard's rules).
 # usage: export_program_fmu.sh PLCFI IMPORTER COSIM SOURCE_DIR
 set -euo pipefail
 plcfi=$1
@@ -45,6 +46,9 @@ grep -Eq '^  output +%QW2 +INT +Integer +PressureSetpoint$' "$work/export.txt"
 unpack "$work/program.fmu" "$work/program"
 unpack "$work/plant.fmu" "$work/plant"
 test -f "$work/program/resources/plcfi/src/000_stamping.st"
+# Both descriptions keep the standard's rules (tests/fmu/fmi2_md_check.py, written from
+# the FMI 2.0 text: attributes, causality/variability/initial, start values, structure).
+/usr/bin/python3 "$src/tests/fmu/fmi2_md_check.py" "$work/program/modelDescription.xml" "$work/plant/modelDescription.xml"
 grep -q 'canGetAndSetFMUstate="true" canSerializeFMUstate="false"' "$work/program/modelDescription.xml"
 variables "$work/program" > "$work/program.vars"
 variables "$work/plant" > "$work/plant.vars"
@@ -176,6 +180,7 @@ ST
 "$plcfi" export-fmu "$work/analog.st" -o "$work/analog.fmu" --cycle-time 5ms | tee "$work/analog.txt"
 grep -q "4 inputs, 4 outputs, 17 fault parameters, base tick 5ms" "$work/analog.txt"
 unpack "$work/analog.fmu" "$work/analog"
+/usr/bin/python3 "$src/tests/fmu/fmi2_md_check.py" "$work/analog/modelDescription.xml"
 variables "$work/analog" > "$work/analog.vars"
 a() { vr "$work/analog.vars" "Main.$1"; }
 id=$(attr "$work/analog" modelIdentifier)
