@@ -113,6 +113,15 @@ fi
 test "$(awk -F, -v c="$(head -n 1 "$work/cosim.csv" | tr ',' '\n' | grep -nx StampDown | cut -d: -f1)" \
   'NR > 1 && $c == 1 && prev != 1 { n++ } { prev = $c } END { print n + 0 }' "$work/cosim.csv")" -ge 2
 echo "6000 steps identical to plcfi sim ($(head -n 1 "$work/cosim.csv" | tr ',' '\n' | wc -l) columns)"
+# The same program as PLCopen XML: the archive keeps the file as it is, the binary
+# imports it as plcfi does.
+"$plcfi" export-fmu "$prog/stamping.xml" -o "$work/xml.fmu" > /dev/null
+unpack "$work/xml.fmu" "$work/xml"
+test -f "$work/xml/resources/plcfi/src/000_stamping.xml"
+setup "$work/xml" > "$work/xml.setup"
+"$cosim" "$work/xml.setup" 0.01 2000 > "$work/xml.csv"
+cmp -s "$work/xml.csv" <(head -n 2001 "$work/sim.csv")
+echo "the program as PLCopen XML: 2000 steps identical"
 
 echo "--- 3. fault parameters: the published failing case F3"
 col() { head -n 1 "$1" | tr ',' '\n' | grep -nx "$2" | cut -d: -f1; }
