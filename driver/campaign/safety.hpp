@@ -19,7 +19,7 @@ namespace plcfi::campaign {
 // The FMEA gives failure rates: the campaign writes its safety evidence.
 inline bool wants_safety_evidence(const Campaign& c) { return c.fmea.has_rates; }
 
-// Definitions (README "Safety evidence"):
+// Definitions (the manual: docs/pages/reports/safety.md):
 // - a row is detected when it has test cases, none NOT REACHED or left untested, each
 //   executed at least once, and every execution PASSED; lambda_DD sums the detected
 //   dangerous rows' rates;

@@ -69,7 +69,7 @@ std::unique_ptr<plant::Plant> open_plant(const std::string& name_or_file, const 
     const bool fmu = name_or_file.ends_with(".fmu");
     if (fmu || name_or_file.ends_with(".st")) {
       *err = fmt::format("{}: an {} plant is named by a plant file (YAML: {}: {}, its step and the map onto the image; "
-                         "see README, 'Your own plant')",
+                         "see docs/pages/formats/plant-files.md)",
                          name_or_file, fmu ? "FMU" : "ST", fmu ? "fmu" : "st", name_or_file);
       return nullptr;
     }

@@ -26,7 +26,7 @@ run() {
 # comparison is about failures, not numbering).
 rows() { tail -n +2 "$work/$1/fmea_suggestions.csv" | cut -d, -f2- | sort; }
 
-# Baseline: stamping_fixed.st. Its exploration finds gaps of its own (see README,
+# Baseline: stamping_fixed.st. Its exploration finds gaps of its own (see the manual,
 # "Exploring beyond the FMEA"); the omissions must add rows to these.
 run fixed "$src/st_programs/stamping/stamping_fixed.st" --explore
 test "$status" -eq 1 || fail "stamping_fixed.st --explore: exit $status"
