@@ -6,7 +6,7 @@
 
 namespace plcfi::plant {
 
-std::unique_ptr<Plant> make_plant(const std::string& name, const std::string& config_path, std::string* err) {
+std::unique_ptr<Plant> make_builtin_plant(const std::string& name, const std::string& config_path, std::string* err) {
   if (name == "stamping") {
     StampingParams params;
     if (!config_path.empty() && !load_stamping_params(config_path, &params, err)) return nullptr;
@@ -19,12 +19,12 @@ std::unique_ptr<Plant> make_plant(const std::string& name, const std::string& co
   }
   if (err) {
     std::string known;
-    for (const auto& n : plant_names()) known += (known.empty() ? "" : ", ") + n;
+    for (const auto& n : builtin_plant_names()) known += (known.empty() ? "" : ", ") + n;
     *err = "unknown plant '" + name + "' (known: " + known + ")";
   }
   return nullptr;
 }
 
-std::vector<std::string> plant_names() { return {"stamping", "bead_dispenser"}; }
+std::vector<std::string> builtin_plant_names() { return {"stamping", "bead_dispenser"}; }
 
 }  // namespace plcfi::plant

@@ -64,10 +64,12 @@ class Plant {
   virtual std::vector<std::string> notes() const { return {}; }
 };
 
-// Creates a plant by name ("stamping"); config_path may be empty (defaults). Returns null
-// and fills err (with file:line for a bad config) when the name or config is invalid.
-std::unique_ptr<Plant> make_plant(const std::string& name, const std::string& config_path, std::string* err);
-// Names accepted by make_plant.
-std::vector<std::string> plant_names();
+// Creates a built-in plant by name ("stamping"); config_path may be empty (defaults).
+// Returns null and fills err (with file:line for a bad config) when the name or config is
+// invalid. Commands and campaigns open plants through io::open_plant, which also takes
+// plant files (an FMU, an ST plant, a built-in one with its map) and calls this one.
+std::unique_ptr<Plant> make_builtin_plant(const std::string& name, const std::string& config_path, std::string* err);
+// Names accepted by make_builtin_plant.
+std::vector<std::string> builtin_plant_names();
 
 }  // namespace plcfi::plant

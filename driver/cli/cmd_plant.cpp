@@ -91,7 +91,7 @@ int plant_export_fmu(const std::vector<std::string>& args) {
     return 2;
   }
   opt.library = exe_dir() + "/" + plant::fmu::kStampingFmuLibrary;
-  auto plant = plant::make_plant("stamping", "", &err);
+  auto plant = plant::make_builtin_plant("stamping", "", &err);
   try {
     plant::fmu::export_stamping_fmu(*plant, opt);
   } catch (const common::InputError& e) {

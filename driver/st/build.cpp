@@ -13,7 +13,7 @@
 
 #include "import/import.hpp"
 #include "syntax/parser.hpp"
-#include "vm/natives.hpp"
+#include "vm/cpp_functions.hpp"
 
 namespace plcfi::st {
 

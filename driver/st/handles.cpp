@@ -15,7 +15,7 @@
 #include "syntax/diag.hpp"
 #include "syntax/parser.hpp"
 #include "vm/memory.hpp"
-#include "vm/natives.hpp"
+#include "vm/cpp_functions.hpp"
 #include "vm/wide.hpp"
 
 namespace plcfi::st {

@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "vm/natives.hpp"
+#include "vm/cpp_functions.hpp"
 
 namespace plcfi::st {
 

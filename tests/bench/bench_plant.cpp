@@ -72,7 +72,7 @@ void BM_stamping_sim_plant_kinds(benchmark::State& state) {
   ex.library = PLCFI_STAMPING_FMU_LIBRARY;
   ex.out = (dir / "stamping.fmu").string();
   ex.plant_file = (dir / "stamping_fmu.yaml").string();
-  auto builtin_model = plant::make_plant("stamping", "", &err);
+  auto builtin_model = plant::make_builtin_plant("stamping", "", &err);
   plant::fmu::export_stamping_fmu(*builtin_model, ex);
 
   Sim builtin = make_sim(*b->app, sched, "stamping", &err);

@@ -35,7 +35,7 @@ class MappedPlant final : public plant::Plant {
 
 std::unique_ptr<plant::Plant> open_builtin(const plant::PlantFile& pf) {
   std::string err;
-  auto inner = plant::make_plant(pf.builtin, pf.config, &err);
+  auto inner = plant::make_builtin_plant(pf.builtin, pf.config, &err);
   if (!inner) throw common::InputError(pf.where + ": " + err);
   std::string origin = pf.path + " (built-in plant " + pf.builtin + ")";
   if (pf.step_ns > 0)
@@ -73,7 +73,7 @@ std::unique_ptr<plant::Plant> open_plant(const std::string& name_or_file, const 
                          name_or_file, fmu ? "FMU" : "ST", fmu ? "fmu" : "st", name_or_file);
       return nullptr;
     }
-    return plant::make_plant(name_or_file, config_path, err);
+    return plant::make_builtin_plant(name_or_file, config_path, err);
   }
   try {
     if (!config_path.empty())

@@ -852,7 +852,7 @@ std::optional<Val> Compiler::emit_bound(const StdFunc& f, const CallExpr& c) {
 }
 
 // The Tc2_System functions: each argument converted to its operand's type as a call of
-// the library's function would convert it, then the native helper (vm/natives.cpp).
+// the library's function would convert it, then the native helper (vm/cpp_functions.cpp).
 std::optional<Val> Compiler::emit_system(const StdFunc& f, const CallExpr& c) {
   auto args = positional(c, f);
   if (args.size() != std::string_view(f.operands).size()) return bad();

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "codegen/compiler.hpp"
-#include "vm/natives.hpp"
+#include "vm/cpp_functions.hpp"
 #include "vm/vm.hpp"
 #include "vm/wide.hpp"
 

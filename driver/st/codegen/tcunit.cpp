@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "compiler_impl.hpp"
-#include "vm/natives.hpp"
+#include "vm/cpp_functions.hpp"
 
 namespace plcfi::st {
 

@@ -26,7 +26,7 @@
 
 #include <fmt/format.h>
 
-#include "vm/natives.hpp"
+#include "vm/cpp_functions.hpp"
 #include "vm/vm.hpp"
 
 extern char** environ;
@@ -1456,7 +1456,7 @@ class Translator {
   }
 
   // The standard functions on numbers (NATIVE with a math id) as direct libm calls the
-  // C++ compiler sees, with the host's arithmetic (natives.cpp): REAL computed in double
+  // C++ compiler sees, with the host's arithmetic (cpp_functions.cpp): REAL computed in double
   // and rounded once.
   static bool math_inline(const uint32_t* w, std::string* out) {
     static const char* const kFn[] = {"sqrt", "log", "log10", "exp", "sin", "cos", "tan", "asin", "acos", "atan", "pow"};

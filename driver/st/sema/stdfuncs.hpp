@@ -13,7 +13,7 @@
 
 #include "sema/types.hpp"
 #include "syntax/ast.hpp"
-#include "vm/natives.hpp"
+#include "vm/cpp_functions.hpp"
 #include "vm/vm.hpp"
 
 namespace plcfi::st {

@@ -1,7 +1,7 @@
 // Beckhoff's Tc2_System library, the parts TwinCAT projects use, written from its public
 // documentation (infosys.beckhoff.com, "Tc2_System"): what can be ST is ST here; MEMCPY,
 // MEMSET, MEMCMP, MEMMOVE, ADSLOGSTR, ADSLOGDINT, ADSLOGLREAL and TIME() are built-ins
-// (sema/stdfuncs.cpp, vm/natives.cpp) because they reach memory, the log or the clock.
+// (sema/stdfuncs.cpp, vm/cpp_functions.cpp) because they reach memory, the log or the clock.
 // Under --dialect codesys an application gets the items its sources name and do not
 // declare (engine.cpp), as the library "<Tc2_System>".
 #include <algorithm>

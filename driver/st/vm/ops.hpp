@@ -177,10 +177,10 @@ inline int wscmp(const uint8_t* a, const uint8_t* b) {
 
 // STRING: bytes ended by a 0 byte, in a variable of capacity cap (cap + 1 bytes). The
 // standard functions work on the variables in place, with no heap: the interpreter's
-// natives (natives.cpp) and the native tier's generated code call these. A result may
+// C++ functions (cpp_functions.cpp) and the native tier's generated code call these. A result may
 // be written over an argument (s := LEFT(s, 2), s := CONCAT(s, t), s := CONCAT(t, s)):
 // every copy is a memmove, made in the order that reads each source before it is
-// overwritten. Lengths and positions are clamped as natives.cpp documents.
+// overwritten. Lengths and positions are clamped as cpp_functions.cpp documents.
 inline size_t slen(const uint8_t* p) { return std::strlen(reinterpret_cast<const char*>(p)); }
 inline void sput(uint8_t* dst, uint32_t cap, const uint8_t* src, size_t n) {
   if (n > cap) n = cap;

@@ -3,7 +3,7 @@
 #include "ops.hpp"
 #include "vm.hpp"
 #include "native/native.hpp"
-#include "natives.hpp"
+#include "cpp_functions.hpp"
 #include "wide.hpp"
 
 #include <bit>

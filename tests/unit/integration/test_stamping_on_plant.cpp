@@ -32,7 +32,7 @@ struct Cell {
     build = st::build_files({program_path(program)}, st::CompileOptions{}, late);
     EXPECT_TRUE(build->ok()) << build->diags.render_all();
     std::string err;
-    auto plant = plant::make_plant("stamping", "", &err);
+    auto plant = plant::make_builtin_plant("stamping", "", &err);
     EXPECT_TRUE(plant) << err;
     backend = io::SimBackend::create(*build->app, std::move(plant), &err);
     EXPECT_TRUE(backend) << err;

@@ -144,11 +144,11 @@ class PlantBeadYaml : public ::testing::Test {
 
 TEST_F(PlantBeadYaml, ByNameWithAndWithoutFile) {
   std::string err;
-  auto plant = make_plant("bead_dispenser", "", &err);
+  auto plant = make_builtin_plant("bead_dispenser", "", &err);
   ASSERT_TRUE(plant) << err;
   EXPECT_EQ(plant->name(), "bead_dispenser");
   auto f = write("gate:\n  release_after: 0.02\nhoppers:\n  white: 3\n");
-  plant = make_plant("bead_dispenser", f, &err);
+  plant = make_builtin_plant("bead_dispenser", f, &err);
   ASSERT_TRUE(plant) << err;
   const auto& prm = static_cast<BeadDispenserPlant&>(*plant).params();
   EXPECT_EQ(prm.release_after, 0.02);
@@ -156,7 +156,7 @@ TEST_F(PlantBeadYaml, ByNameWithAndWithoutFile) {
   EXPECT_EQ(prm.hopper_beads[0], 50);
   EXPECT_EQ(prm.hopper_beads[1], 3);
   bool listed = false;
-  for (const auto& n : plant_names()) listed = listed || n == "bead_dispenser";
+  for (const auto& n : builtin_plant_names()) listed = listed || n == "bead_dispenser";
   EXPECT_TRUE(listed);
 }
 

@@ -561,7 +561,7 @@ class PlantStampingYaml : public ::testing::Test {
 
 TEST_F(PlantStampingYaml, DefaultsWithoutFile) {
   std::string err;
-  auto plant = make_plant("stamping", "", &err);
+  auto plant = make_builtin_plant("stamping", "", &err);
   ASSERT_TRUE(plant) << err;
   const auto& p = static_cast<StampingPlant&>(*plant).params();
   EXPECT_EQ(p.slider_travel, 0.30);
@@ -583,7 +583,7 @@ TEST_F(PlantStampingYaml, DefaultsWithoutFile) {
   EXPECT_EQ(p.operator_press_time, 0.2);
   EXPECT_TRUE(p.operator_ack_at.empty());
   EXPECT_TRUE(p.operator_jogs.empty());
-  EXPECT_EQ(plant_names(), (std::vector<std::string>{"stamping", "bead_dispenser"}));
+  EXPECT_EQ(builtin_plant_names(), (std::vector<std::string>{"stamping", "bead_dispenser"}));
 }
 
 TEST_F(PlantStampingYaml, DocumentedFileIsTheDefaults) {
@@ -647,7 +647,7 @@ operator:
     - {button: stamp, from: 1, to: 2}
 )";
   std::string err;
-  auto plant = make_plant("stamping", write(text), &err);
+  auto plant = make_builtin_plant("stamping", write(text), &err);
   ASSERT_TRUE(plant) << err;
   const auto& p = static_cast<StampingPlant&>(*plant).params();
   EXPECT_EQ(p.variation, 0.05);
@@ -712,7 +712,7 @@ TEST_F(PlantStampingYaml, ErrorsNameFileLineColumn) {
   for (const auto& c : cases) {
     const std::string path = write(c.text);
     std::string err;
-    EXPECT_EQ(make_plant("stamping", path, &err), nullptr) << c.text;
+    EXPECT_EQ(make_builtin_plant("stamping", path, &err), nullptr) << c.text;
     EXPECT_EQ(err, path + ":" + c.expected) << c.text;
   }
 }
@@ -720,16 +720,16 @@ TEST_F(PlantStampingYaml, ErrorsNameFileLineColumn) {
 TEST_F(PlantStampingYaml, SyntaxErrorMissingFileUnknownPlant) {
   const std::string path = write("stamp:\n  travel: [0.2\n");
   std::string err;
-  EXPECT_EQ(make_plant("stamping", path, &err), nullptr);
+  EXPECT_EQ(make_builtin_plant("stamping", path, &err), nullptr);
   EXPECT_TRUE(std::regex_match(err, std::regex(std::regex_replace(path, std::regex("[.]"), "[.]") + ":[0-9]+:[0-9]+: .+"))) << err;
 
   const std::string missing = (dir_ / "nope.yaml").string();
-  EXPECT_EQ(make_plant("stamping", missing, &err), nullptr);
+  EXPECT_EQ(make_builtin_plant("stamping", missing, &err), nullptr);
   EXPECT_EQ(err, missing + ": cannot open (No such file or directory)");
-  EXPECT_EQ(make_plant("stamping", dir_.string(), &err), nullptr);
+  EXPECT_EQ(make_builtin_plant("stamping", dir_.string(), &err), nullptr);
   EXPECT_EQ(err, dir_.string() + ": is a directory");
 
-  EXPECT_EQ(make_plant("press", "", &err), nullptr);
+  EXPECT_EQ(make_builtin_plant("press", "", &err), nullptr);
   EXPECT_EQ(err, "unknown plant 'press' (known: stamping, bead_dispenser)");
 }
 

@@ -31,7 +31,7 @@ class BeadStand {
     EXPECT_TRUE(b->ok()) << b->diags.render_all();
     std::string err;
     EXPECT_TRUE(sched.from_configuration(*b->app, &err)) << err;
-    sim = io::SimBackend::create(*b->app, plant::make_plant("bead_dispenser", "", &err), &err);
+    sim = io::SimBackend::create(*b->app, plant::make_builtin_plant("bead_dispenser", "", &err), &err);
     EXPECT_TRUE(sim) << err;
     link = std::make_unique<io::LinkFaultBackend>(sim.get(), "plant");
     rt = std::make_unique<rt::Runtime>(*b->app, sched, link.get());

@@ -1,4 +1,6 @@
-// Identifiers of the native helper functions called by the NATIVE instruction.
+// The standard functions implemented in C++ (not open-coded by the compiler): their
+// identifiers, called by the NATIVE instruction. Not to be confused with native/, the
+// native tier, which translates whole programs to C++.
 #pragma once
 
 #include <cstdint>
@@ -8,7 +10,7 @@ namespace plcfi::st {
 
 // Operand conventions (a, b, c, d are frame pointers; cap = result string capacity):
 //   math:   a := f(b) on F32 or F64 (EXPT: a := b ** c)
-//   string: see natives.cpp for each function's operands; integer operands are I64.
+//   string: see cpp_functions.cpp for each function's operands; integer operands are I64.
 enum class Native : uint32_t {
 #define PLCFI_NATIVE_MATH(X) X(SQRT) X(LN) X(LOG) X(EXP) X(SIN) X(COS) X(TAN) X(ASIN) X(ACOS) X(ATAN) X(EXPT)
 #define X(n) n##_F32, n##_F64,

@@ -1,7 +1,7 @@
 // Native helpers for the standard functions that are not open-coded: transcendental
 // math, the string functions and conversions between values and text. All string
 // results are truncated to the destination's capacity and stay NUL-terminated.
-#include "natives.hpp"
+#include "cpp_functions.hpp"
 
 #include <cmath>
 #include <cstdint>
