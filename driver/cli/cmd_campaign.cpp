@@ -239,10 +239,10 @@ int cmd_generate(const std::vector<std::string>& args) {
   return 0;
 }
 
-int cmd_campaign(const std::vector<std::string>& args) {
-  const std::string usage =
-      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--explore] [--no-vcd] [--html DIR] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N] [--baseline OLD_OUT [--fail-on-regression]]";
-  po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
+namespace {
+
+// The options of `plcfi campaign`.
+void add_campaign_options(po::options_description& desc) {
   desc.add_options()
       ("out", po::value<std::string>(), "output folder: results.jsonl, VCD per test, diagrams (default plcfi-out/<campaign>-<program>)")
       ("resume", "finish a campaign whose journal is in the output folder (no case runs twice)")
@@ -267,208 +267,285 @@ int cmd_campaign(const std::vector<std::string>& args) {
       ("shard", po::value<std::string>(), "run share K of N (K = 0..N-1) into OUT/shard-K-of-N.jsonl; `plcfi merge` "
                                           "combines the N shard files into the campaign's journal");
   add_coverage_export_options(desc);
-  po::variables_map vm;
-  if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
-  if (!check_coverage_paths(vm, "plcfi campaign")) return 2;
-  const int jobs = vm.count("jobs") ? static_cast<int>(vm["jobs"].as<IntIn<1, 256>>().value) : 1;
-  int shard_k = 0, shard_n = 0;
+}
+
+// The command line, checked: how the runs are split, where the results go, what they are
+// compared with.
+struct CampaignArgs {
+  int jobs = 1;
+  int shard_k = 0, shard_n = 0;  // shard_n 0: no --shard
+  std::string out;
+  std::optional<report::SafetyReport> baseline;  // --baseline: the earlier run's evidence
+  bool live = false;                             // the progress line on stderr
+};
+
+// --jobs and --shard, and the options that do not go with them. False after printing why.
+bool split_options(const po::variables_map& vm, CampaignArgs* a) {
+  a->jobs = vm.count("jobs") ? static_cast<int>(vm["jobs"].as<IntIn<1, 256>>().value) : 1;
   if (vm.count("shard")) {
     std::string why;
-    if (!campaign::parse_share(vm["shard"].as<std::string>(), &shard_k, &shard_n, &why)) {
+    if (!campaign::parse_share(vm["shard"].as<std::string>(), &a->shard_k, &a->shard_n, &why)) {
       std::cerr << "plcfi campaign: --shard " << why << "\n";
-      return 2;
+      return false;
     }
     for (const char* o : {"jobs", "resume", "junit", "html", "lcov", "cobertura", "io", "realtime"})
       if (vm.count(o)) {
         std::cerr << "plcfi campaign: --shard runs one share of an offline campaign; --" << o
                   << " does not go with it (run `plcfi merge` on the shard files, then look at the journal)\n";
-        return 2;
+        return false;
       }
   }
-  if (jobs > 1)
+  if (a->jobs > 1)
     for (const char* o : {"io", "realtime", "lcov", "cobertura"})
       if (vm.count(o)) {
         std::cerr << "plcfi campaign: --jobs splits an offline campaign between processes; --" << o
                   << (std::string(o) == "io" || std::string(o) == "realtime" ? " runs on one machine's real time"
                                                                               : " counts the scans of one process")
                   << ": drop --jobs\n";
-        return 2;
+        return false;
       }
-  CampaignBuild cb;
+  return true;
+}
+
+// The campaign file with the command line's --program, --seed, --plant and --explore,
+// prepared. False after printing why.
+bool load_with_options(const po::variables_map& vm, CampaignBuild* cb) {
   std::vector<std::string> programs;
   if (vm.count("program")) programs = vm["program"].as<std::vector<std::string>>();
   uint64_t seed = vm.count("seed") ? vm["seed"].as<Count>().value : 0;
-  if (!load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, vm.count("seed") ? &seed : nullptr, &cb,
-                        vm.count("plant") ? vm["plant"].as<std::string>() : "", vm.count("explore") > 0))
-    return 2;
-  const auto& c = cb.spec;
-  if ((jobs > 1 || shard_n > 0) && !c.io.empty()) {
+  return load_and_prepare(vm["campaign-file"].as<std::vector<std::string>>()[0], programs, vm.count("seed") ? &seed : nullptr, cb,
+                          vm.count("plant") ? vm["plant"].as<std::string>() : "", vm.count("explore") > 0);
+}
+
+// Runs split between processes (--jobs, --shard) need an offline campaign that restarts
+// cold. False after printing why.
+bool splittable(const CampaignArgs& a, const campaign::Campaign& c) {
+  if (a.jobs <= 1 && a.shard_n == 0) return true;
+  if (!c.io.empty()) {
     std::cerr << "plcfi campaign: " << c.path << ": the campaign runs on real I/O (io: " << c.io
               << "); --jobs and --shard split offline campaigns only\n";
-    return 2;
+    return false;
   }
-  if ((jobs > 1 || shard_n > 0) && c.restart == campaign::RestartKind::Warm) {
+  if (c.restart == campaign::RestartKind::Warm) {
     std::cerr << "plcfi campaign: " << c.path
               << ": restart: warm carries each run's retained state into the next run, so the runs cannot be split "
                  "between processes; use restart: cold for --jobs or --shard\n";
-    return 2;
+    return false;
   }
-  std::string out = vm.count("out") ? vm["out"].as<std::string>()
-                                    : (std::filesystem::path("plcfi-out") /
-                                       (c.name + "-" + std::filesystem::path(c.programs.back()).stem().string()))
-                                          .string();
-  std::string err;
-  // The baseline is read before the campaign runs: a wrong folder is a usage error, not a
-  // surprise after an hour of testing.
-  std::optional<report::SafetyReport> baseline;
+  return true;
+}
+
+// --out, else plcfi-out/<campaign>-<program>.
+std::string out_dir(const po::variables_map& vm, const campaign::Campaign& c) {
+  return vm.count("out") ? vm["out"].as<std::string>()
+                         : (std::filesystem::path("plcfi-out") /
+                            (c.name + "-" + std::filesystem::path(c.programs.back()).stem().string()))
+                               .string();
+}
+
+// --baseline (and --fail-on-regression, which needs it) into a->baseline. The baseline is
+// read before the campaign runs: a wrong folder is a usage error, not a surprise after an
+// hour of testing. False after printing why.
+bool read_baseline(const po::variables_map& vm, const campaign::Campaign& c, CampaignArgs* a) {
   if (vm.count("fail-on-regression") && !vm.count("baseline")) {
     std::cerr << "plcfi campaign: --fail-on-regression compares with an earlier run: add --baseline OLD_OUT\n";
-    return 2;
+    return false;
   }
-  if (vm.count("baseline")) {
-    if (shard_n > 0) {
-      std::cerr << "plcfi campaign: --baseline compares a whole campaign; it does not go with --shard\n";
-      return 2;
-    }
-    if (!campaign::wants_safety_evidence(c)) {
-      std::cerr << "plcfi campaign: --baseline compares safety evidence, and " << c.fmea.path
-                << " has no failure_rate column (see README, \"Safety evidence\")\n";
-      return 2;
-    }
-    std::string path = (std::filesystem::path(vm["baseline"].as<std::string>()) / "safety.json").string(), text;
-    baseline.emplace();
-    if (!common::read_file(path, common::kMaxSpecBytes, &text, &err) || !report::parse_safety_json(text, path, &*baseline, &err)) {
-      std::cerr << "plcfi campaign: --baseline: " << err << "\n";
-      return 2;
-    }
+  if (!vm.count("baseline")) return true;
+  if (a->shard_n > 0) {
+    std::cerr << "plcfi campaign: --baseline compares a whole campaign; it does not go with --shard\n";
+    return false;
   }
-  if (vm.count("html") && !html_dir_writable(vm["html"].as<std::string>(), &err)) {  // before a long campaign, not after it
+  if (!campaign::wants_safety_evidence(c)) {
+    std::cerr << "plcfi campaign: --baseline compares safety evidence, and " << c.fmea.path
+              << " has no failure_rate column (see README, \"Safety evidence\")\n";
+    return false;
+  }
+  std::string path = (std::filesystem::path(vm["baseline"].as<std::string>()) / "safety.json").string(), text, err;
+  a->baseline.emplace();
+  if (!common::read_file(path, common::kMaxSpecBytes, &text, &err) || !report::parse_safety_json(text, path, &*a->baseline, &err)) {
+    std::cerr << "plcfi campaign: --baseline: " << err << "\n";
+    return false;
+  }
+  return true;
+}
+
+// The output folders, before a long campaign rather than after it: the HTML report's is
+// writable, the diagrams are written. False after printing why.
+bool prepare_outputs(const po::variables_map& vm, const CampaignBuild& cb, const std::string& out) {
+  std::string err;
+  if (vm.count("html") && !html_dir_writable(vm["html"].as<std::string>(), &err)) {
     std::cerr << "plcfi campaign: " << err << "\n";
-    return 2;
+    return false;
   }
   if (!write_diagrams(cb, (std::filesystem::path(out) / "diagrams").string(), &err)) {
     std::cerr << "plcfi campaign: " << err << "\n";
-    return 2;
+    return false;
   }
-  std::cout << fmt::format("plcfi campaign {}: {} test case(s), program {}, plant {}, seed {}\n", c.name, cb.cases.size(),
-                           c.programs.back(), c.plant, c.seed);
-  bool live = !vm.count("quiet") && isatty(STDERR_FILENO);
+  return true;
+}
+
+// A test's verdict, printed as it ends.
+void print_verdict_line(const CampaignBuild& cb, const campaign::Execution& e) {
+  std::cout << fmt::format("  [run {:>2}, t={:7.3f} s] {} path {} {}: {}\n", e.run, static_cast<double>(e.inject_ns) * 1e-9,
+                           e.case_id, e.path, campaign::outcome_name(e.outcome), cb.cases[e.case_index].transition_ref())
+            << std::flush;
+}
+
+// The driver's options from the command line. With a.live, a progress line on stderr that
+// each verdict line clears and writes again.
+campaign::DriverOptions driver_options(const po::variables_map& vm, const CampaignBuild& cb, const CampaignArgs& a,
+                                       const st::NativeCode* native, std::vector<uint64_t>* branch_hits) {
   campaign::DriverOptions opt;
-  std::unique_ptr<st::NativeCode> native;
-  if (vm.count("native") && !(native = load_native(*cb.build->app, "plcfi campaign"))) return 2;
-  opt.native = native.get();
-  opt.out_dir = out;
+  opt.native = native;
+  opt.out_dir = a.out;
   opt.resume = vm.count("resume") > 0;
   opt.vcd = !vm.count("no-vcd");
-  std::vector<uint64_t> branch_hits;  // --lcov/--cobertura
-  if (coverage_export_wanted(vm)) opt.branch_hits = &branch_hits;
-  auto progress_line = [&](const campaign::Progress& p) {
+  if (coverage_export_wanted(vm)) opt.branch_hits = branch_hits;
+  auto progress_line = [live = a.live](const campaign::Progress& p) {
     if (!live) return;
     std::cerr << fmt::format("\r  run {:>3}  cases tested {}/{}  PASS {}  FAIL {}  t = {:.1f} s   ", p.run, p.cases_tested,
                              p.cases, p.pass, p.fail, static_cast<double>(p.campaign_ns) * 1e-9)
               << std::flush;
   };
   opt.on_progress = progress_line;
-  opt.on_verdict = [&](const campaign::Execution& e, const campaign::Progress& p) {
+  opt.on_verdict = [&cb, live = a.live, progress_line](const campaign::Execution& e, const campaign::Progress& p) {
     if (live) std::cerr << "\r" << std::string(72, ' ') << "\r";
-    const auto& tc = cb.cases[e.case_index];
-    std::cout << fmt::format("  [run {:>2}, t={:7.3f} s] {} path {} {}: {}\n", e.run, static_cast<double>(e.inject_ns) * 1e-9, e.case_id,
-                             e.path, campaign::outcome_name(e.outcome), tc.transition_ref())
-              << std::flush;
+    print_verdict_line(cb, e);
     progress_line(p);
   };
-  if (shard_n > 0) {
-    opt.on_progress = nullptr;
-    opt.on_verdict = [&](const campaign::Execution& e, const campaign::Progress&) {
-      std::cout << fmt::format("  [run {:>2}, t={:7.3f} s] {} path {} {}: {}\n", e.run, static_cast<double>(e.inject_ns) * 1e-9,
-                               e.case_id, e.path, campaign::outcome_name(e.outcome), cb.cases[e.case_index].transition_ref())
-                << std::flush;
-    };
-    const std::string shard_path =
-        (std::filesystem::path(out) / fmt::format("shard-{}-of-{}.jsonl", shard_k, shard_n)).string();
-    campaign::ShardSummary sum;
-    if (!campaign::run_campaign_shard(cb, shard_k, shard_n, opt, shard_path, &sum, &err)) {
-      std::cerr << "plcfi campaign: " << err << "\n";
-      return 2;
-    }
-    std::cout << fmt::format("\nshard {}/{}: {} run(s) searched, {} tested here: {} PASS, {} FAIL; stopped: {}\n", shard_k,
-                             shard_n, sum.runs, sum.executions, sum.pass, sum.fail, sum.end_reason);
-    std::cout << fmt::format("shard file {}; combine the {} shard files with: plcfi merge --out DIR FILES...\n", shard_path,
-                             shard_n);
-    return 0;
-  }
-  campaign::CampaignResult res;
-  std::string io_path = vm.count("io") ? vm["io"].as<std::string>() : c.io;
-  bool ran = false;
-  std::vector<std::string> io_report;
-  rt::RealtimeOptions rto;
-  std::optional<rt::StopSignals> signals;  // installed for real-time runs only
-  rto.priority = static_cast<int>(vm["rt-priority"].as<RtPriority>().value);
-  rto.cpu = static_cast<int>(vm["cpu"].as<CpuIndex>().value);
-  if (!io_path.empty()) {
-    if (!vm.count("arm")) {
-      std::cerr << "plcfi campaign: refusing to inject faults on real I/O (" << io_path
-                << ") without --arm: the campaign forces sensor values and suppresses or changes actuator commands on the "
-                   "machine. Make sure the bench is safe to run and that stopping it is possible, then add --arm.\n";
-      return 2;
-    }
-    io::IoConfig io_cfg;
-    if (!io::load_io_config(io_path, *cb.build->app, &io_cfg, &err)) {
-      std::cerr << err << "\n";
-      return 2;
-    }
-    auto backend = io::BenchIo::open(io_cfg, cb.schedule.tick_ns(), &err);
-    if (!backend) {
-      std::cerr << err << "\n";
-      return 2;
-    }
-    signals.emplace();
-    opt.realtime = true;
-    warn_realtime_setup(rto, "plcfi campaign");
-    opt.signals = &*signals;
-    auto* bench = backend.get();
-    opt.io_lost = [bench] { return bench->lost(); };
-    opt.safe_state = io_cfg.safe_state;
-    std::cout << fmt::format("  armed: real I/O over {} in real time; SIGINT/SIGTERM withdraw the fault and write the safe state\n",
-                             io_path);
-    ran = campaign::run_campaign_on(cb, backend.get(), opt, &res, &err);
-    backend->close();
-    io_report = backend->report();
-  } else {
-    if (vm.count("realtime")) {
-      // The simulated plant at the speed of the real one: a rehearsal of the bench run.
-      signals.emplace();
-      opt.realtime = true;
-      opt.signals = &*signals;
-      warn_realtime_setup(rto, "plcfi campaign");
-    }
-    if (jobs > 1) {
-      if (live) std::cerr << fmt::format("  {} worker processes\n", jobs);
-      opt.on_progress = nullptr;
-      ran = campaign::run_campaign_jobs(cb, jobs, opt, &res, &err);
-    } else {
-      ran = campaign::run_campaign(cb, opt, &res, &err);
-    }
-  }
-  if (!ran) {
-    if (live) std::cerr << "\n";
+  return opt;
+}
+
+// --shard K/N: this share's runs into OUT/shard-K-of-N.jsonl (`plcfi merge` makes the
+// journal of the N files), verdict lines without the progress line.
+int run_shard(CampaignBuild& cb, const CampaignArgs& a, campaign::DriverOptions opt) {
+  opt.on_progress = nullptr;
+  opt.on_verdict = [&cb](const campaign::Execution& e, const campaign::Progress&) { print_verdict_line(cb, e); };
+  const std::string shard_path =
+      (std::filesystem::path(a.out) / fmt::format("shard-{}-of-{}.jsonl", a.shard_k, a.shard_n)).string();
+  campaign::ShardSummary sum;
+  std::string err;
+  if (!campaign::run_campaign_shard(cb, a.shard_k, a.shard_n, opt, shard_path, &sum, &err)) {
     std::cerr << "plcfi campaign: " << err << "\n";
     return 2;
   }
-  if (live) std::cerr << "\r" << std::string(72, ' ') << "\r";
-  if (res.resumed) std::cout << fmt::format("  resumed: {} verdict(s) read from {}/results.jsonl\n", res.resumed, out);
+  std::cout << fmt::format("\nshard {}/{}: {} run(s) searched, {} tested here: {} PASS, {} FAIL; stopped: {}\n", a.shard_k,
+                           a.shard_n, sum.runs, sum.executions, sum.pass, sum.fail, sum.end_reason);
+  std::cout << fmt::format("shard file {}; combine the {} shard files with: plcfi merge --out DIR FILES...\n", shard_path,
+                           a.shard_n);
+  return 0;
+}
 
-  // Summary table.
+// What a finished campaign leaves for the summary and the reports.
+struct Finished {
+  campaign::CampaignResult res;
+  std::vector<std::string> io_report;  // real I/O: the devices' figures
+};
+
+// The devices of the io file, opened for a campaign on real I/O. Null after printing why:
+// no --arm, a bad io file, devices that cannot be opened.
+std::unique_ptr<io::BenchIo> open_bench(const std::string& io_path, bool armed, const CampaignBuild& cb, io::IoConfig* cfg) {
+  if (!armed) {
+    std::cerr << "plcfi campaign: refusing to inject faults on real I/O (" << io_path
+              << ") without --arm: the campaign forces sensor values and suppresses or changes actuator commands on the "
+                 "machine. Make sure the bench is safe to run and that stopping it is possible, then add --arm.\n";
+    return nullptr;
+  }
+  std::string err;
+  if (!io::load_io_config(io_path, *cb.build->app, cfg, &err)) {
+    std::cerr << err << "\n";
+    return nullptr;
+  }
+  auto backend = io::BenchIo::open(*cfg, cb.schedule.tick_ns(), &err);
+  if (!backend) std::cerr << err << "\n";
+  return backend;
+}
+
+// The campaign on the bench, in real time: a stop signal or a lost device withdraws the
+// fault and writes the safe state. The devices are closed after it.
+bool run_on_bench(io::BenchIo& bench, const io::IoConfig& cfg, const std::string& io_path, CampaignBuild& cb,
+                  const rt::RealtimeOptions& rto, std::optional<rt::StopSignals>& signals, campaign::DriverOptions& opt,
+                  Finished* f, std::string* err) {
+  signals.emplace();
+  opt.realtime = true;
+  warn_realtime_setup(rto, "plcfi campaign");
+  opt.signals = &*signals;
+  auto* lost = &bench;
+  opt.io_lost = [lost] { return lost->lost(); };
+  opt.safe_state = cfg.safe_state;
+  std::cout << fmt::format("  armed: real I/O over {} in real time; SIGINT/SIGTERM withdraw the fault and write the safe state\n",
+                           io_path);
+  bool ran = campaign::run_campaign_on(cb, &bench, opt, &f->res, err);
+  bench.close();
+  f->io_report = bench.report();
+  return ran;
+}
+
+// The campaign on the plant model: in virtual time, or with --realtime at the speed of the
+// real plant (a rehearsal of the bench run); with --jobs on worker processes.
+bool run_offline(bool realtime, CampaignBuild& cb, const CampaignArgs& a, const rt::RealtimeOptions& rto,
+                 std::optional<rt::StopSignals>& signals, campaign::DriverOptions& opt, Finished* f, std::string* err) {
+  if (realtime) {
+    signals.emplace();
+    opt.realtime = true;
+    opt.signals = &*signals;
+    warn_realtime_setup(rto, "plcfi campaign");
+  }
+  if (a.jobs > 1) {
+    if (a.live) std::cerr << fmt::format("  {} worker processes\n", a.jobs);
+    opt.on_progress = nullptr;
+    return campaign::run_campaign_jobs(cb, a.jobs, opt, &f->res, err);
+  }
+  return campaign::run_campaign(cb, opt, &f->res, err);
+}
+
+// Runs the campaign on real I/O (--io or the campaign's io:) or on the plant model. The
+// stop signals of a real-time run go into `signals`, installed until the command ends.
+// False after printing why.
+bool run(const po::variables_map& vm, CampaignBuild& cb, const CampaignArgs& a, std::optional<rt::StopSignals>& signals,
+         campaign::DriverOptions& opt, Finished* f) {
+  std::string io_path = vm.count("io") ? vm["io"].as<std::string>() : cb.spec.io;
+  rt::RealtimeOptions rto;
+  rto.priority = static_cast<int>(vm["rt-priority"].as<RtPriority>().value);
+  rto.cpu = static_cast<int>(vm["cpu"].as<CpuIndex>().value);
+  std::string err;
+  bool ran = false;
+  if (!io_path.empty()) {
+    io::IoConfig cfg;
+    auto bench = open_bench(io_path, vm.count("arm") > 0, cb, &cfg);
+    if (!bench) return false;
+    ran = run_on_bench(*bench, cfg, io_path, cb, rto, signals, opt, f, &err);
+  } else {
+    ran = run_offline(vm.count("realtime") > 0, cb, a, rto, signals, opt, f, &err);
+  }
+  if (!ran) {
+    if (a.live) std::cerr << "\n";
+    std::cerr << "plcfi campaign: " << err << "\n";
+    return false;
+  }
+  return true;
+}
+
+// A case without an execution in the summary table: NOT REACHED or NOT TESTED, and why.
+void print_unrun_row(const TestCase& tc, const char* verdict, const std::string& why) {
+  std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad("-", 5), pad(verdict, 12), pad("-", 9),
+                           pad(std::to_string(tc.rpn), 4), pad(tc.transition_ref(), 30), why);
+}
+
+// The summary table: the executions by case and path, then the cases that did not run.
+// Returns the number of executions that did not pass.
+size_t print_verdict_table(const CampaignBuild& cb, const campaign::CampaignResult& res) {
   std::cout << fmt::format("\n{} {} {} {} {} {} {}\n", pad("case", 5), pad("path", 5), pad("verdict", 12), pad("latency", 9),
                            pad("RPN", 4), pad("transition", 30), "fault / reason");
-  size_t pass = 0, fail = 0;
+  size_t fail = 0;
   std::vector<campaign::Execution> table = res.executions;  // by case, then path
   std::stable_sort(table.begin(), table.end(), [](const auto& a, const auto& b) {
     return std::tie(a.case_index, a.path) < std::tie(b.case_index, b.path);
   });
   for (const auto& e : table) {
     const auto& tc = cb.cases[e.case_index];
-    (e.outcome == campaign::Outcome::Pass ? pass : fail)++;
+    fail += e.outcome != campaign::Outcome::Pass;
     std::string lat = e.latency_ns >= 0 ? fmt::format("{:.0f} ms", static_cast<double>(e.latency_ns) * 1e-6) : "-";
     std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(e.case_id, 5), pad(std::to_string(e.path), 5),
                              pad(campaign::outcome_name(e.outcome), 12), pad(lat, 9), pad(std::to_string(tc.rpn), 4),
@@ -481,21 +558,20 @@ int cmd_campaign(const std::vector<std::string>& args) {
       std::cout << fmt::format("{}path: {}\n", std::string(38, ' '), list);
     }
   }
-  for (size_t i : res.not_reached) {
-    const auto& tc = cb.cases[i];
-    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad("-", 5), pad("NOT REACHED", 12), pad("-", 9),
-                             pad(std::to_string(tc.rpn), 4), pad(tc.transition_ref(), 30),
-                             "precondition never held: " + tc.precondition);
-  }
-  for (size_t i : res.pending) {
-    const auto& tc = cb.cases[i];
-    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad("-", 5), pad("NOT TESTED", 12), pad("-", 9),
-                             pad(std::to_string(tc.rpn), 4), pad(tc.transition_ref(), 30), "campaign interrupted before this case");
-  }
+  for (size_t i : res.not_reached)
+    print_unrun_row(cb.cases[i], "NOT REACHED", "precondition never held: " + cb.cases[i].precondition);
+  for (size_t i : res.pending) print_unrun_row(cb.cases[i], "NOT TESTED", "campaign interrupted before this case");
+  return fail;
+}
+
+// The totals, the run's figures (scans, time, real-time and I/O figures) and where the
+// files are.
+void print_totals(const CampaignBuild& cb, const Finished& f, size_t fail, const std::string& out) {
+  const auto& res = f.res;
   const auto& p = res.progress;
   std::cout << fmt::format(
-      "\n{} execution(s) of {} case(s): {} PASS, {} FAIL, {} NOT REACHED\n", res.executions.size(), cb.cases.size(), pass,
-      fail, res.not_reached.size());
+      "\n{} execution(s) of {} case(s): {} PASS, {} FAIL, {} NOT REACHED\n", res.executions.size(), cb.cases.size(),
+      res.executions.size() - fail, fail, res.not_reached.size());
   std::cout << fmt::format("{} run(s), {} scans, {:.1f} s on the scan clock in {:.3f} s wall time; ended: {}\n", p.run,
                            p.scans, static_cast<double>(p.campaign_ns) * 1e-9, res.wall_s, res.end_reason);
   std::cout << fmt::format("journal {}/results.jsonl, traces and diagrams in {}\n", out, out);
@@ -503,105 +579,137 @@ int cmd_campaign(const std::vector<std::string>& args) {
     std::istringstream lines(res.realtime_text);
     for (std::string l; std::getline(lines, l);) std::cout << "  " << l << "\n";
   }
-  for (const auto& l : io_report) std::cout << "  " << l << "\n";
-  if (cb.spec.explore.enabled && !print_suggestions(cb, res, out)) return 2;
-  // Safety evidence, only when the FMEA gives failure rates (else nothing changes).
-  std::optional<report::SafetyReport> safety;
-  if (campaign::wants_safety_evidence(c)) {
-    safety = campaign::safety_evidence(cb, res.executions, res.not_reached, res.pending, opt.vcd);
-    for (const auto& [name, text] : {std::pair{"safety.json", report::safety_json(*safety)},
-                                     {"traceability.csv", report::traceability_csv(*safety)}}) {
-      std::string path = (std::filesystem::path(out) / name).string();
-      std::ofstream f(path, std::ios::binary);
-      f << text;
-      if (!f) {
-        std::cerr << "plcfi campaign: " << path << ": cannot write\n";
-        return 2;
-      }
-    }
-    std::cout << report::safety_text(*safety, out);
-  }
-  size_t regressions = 0;
-  if (baseline) {
-    auto changes = report::compare_safety(*baseline, *safety);
-    for (const auto& ch : changes) regressions += ch.regression;
-    const std::string old = vm["baseline"].as<std::string>();
-    if (changes.empty()) {
-      std::cout << fmt::format("no change since {} (baseline)\n", old);
-    } else {
-      std::cout << fmt::format("{} change(s) since {} (baseline), {} regression(s)\n", changes.size(), old, regressions);
-      for (const auto& ch : changes) std::cout << fmt::format("  {} {}\n", ch.regression ? "REGRESSION" : "changed   ", ch.what);
-    }
-  }
+  for (const auto& l : f.io_report) std::cout << "  " << l << "\n";
+}
 
-  if (vm.count("junit")) {
-    report::JunitSuite suite;
-    suite.name = "campaign." + c.name;
-    for (const auto& e : res.executions) {
-      const auto& tc = cb.cases[e.case_index];
-      report::JunitCase jc;
-      jc.classname = suite.name + "." + tc.transition_ref();
-      jc.name = fmt::format("{} path {}: {}", e.case_id, e.path, tc.row->failure_mode);
-      jc.seconds = static_cast<double>(e.end_ns - e.inject_ns) * 1e-9;
-      jc.outcome = e.outcome == campaign::Outcome::Pass ? report::JunitCase::Outcome::Pass : report::JunitCase::Outcome::Fail;
-      if (e.outcome != campaign::Outcome::Pass) jc.message = e.reason;
-      jc.detail = fmt::format("precondition: {}\nfault: {}\nexpected: {}\nresult: {}", tc.precondition, fault_text(tc),
-                              tc.expected, e.reason);
-      std::string dist;
-      for (const auto& d : campaign::distinguishing_branches(cb, res.executions, e)) dist += (dist.empty() ? "" : ", ") + d;
-      jc.properties = {{"rpn", std::to_string(tc.rpn)},
-                       {"fault_class", tc.cls->id},
-                       {"fmea", tc.row->id},
-                       {"path", std::to_string(e.path)},
-                       {"path_branches", dist},
-                       {"fault", fault_text(tc)},
-                       {"latency_ms", e.latency_ns >= 0 ? fmt::format("{:.1f}", static_cast<double>(e.latency_ns) * 1e-6) : ""},
-                       {"vcd", e.vcd}};
-      suite.cases.push_back(jc);
-    }
-    suite.properties = res.realtime;
-    suite.properties.emplace_back("plant", cb.spec.plant);
-    for (size_t i = 0; i < io_report.size(); ++i) suite.properties.emplace_back(fmt::format("io_{}", i), io_report[i]);
-    if (res.interrupted) suite.properties.emplace_back("incomplete", res.end_reason);
-    if (safety)
-      for (auto& prop : report::safety_junit_properties(*safety)) suite.properties.push_back(std::move(prop));
-    for (size_t i : res.pending) {
-      const auto& tc = cb.cases[i];
-      report::JunitCase jc;
-      jc.classname = suite.name + "." + tc.transition_ref();
-      jc.name = fmt::format("{}: {}", tc.id, tc.row->failure_mode);
-      jc.outcome = report::JunitCase::Outcome::Skipped;
-      jc.message = "not tested: the campaign was interrupted (" + res.end_reason + "); finish it with --resume";
-      suite.cases.push_back(jc);
-    }
-    for (size_t i : res.not_reached) {
-      const auto& tc = cb.cases[i];
-      report::JunitCase jc;
-      jc.classname = suite.name + "." + tc.transition_ref();
-      jc.name = fmt::format("{}: {}", tc.id, tc.row->failure_mode);
-      jc.outcome = report::JunitCase::Outcome::Skipped;
-      jc.message = "NOT REACHED: the precondition never held (coverage gap): " + tc.precondition;
-      jc.properties = {{"rpn", std::to_string(tc.rpn)}, {"fault_class", tc.cls->id}, {"fmea", tc.row->id}};
-      suite.cases.push_back(jc);
-    }
-    if (!report::write_junit(vm["junit"].as<std::string>(), {suite}, &err)) {
-      std::cerr << "plcfi campaign: " << err << "\n";
-      return 2;
+// Safety evidence, only when the FMEA gives failure rates (else nothing changes): into
+// *safety, OUT/safety.json and OUT/traceability.csv, and printed. False after printing why.
+bool write_safety_evidence(const CampaignBuild& cb, const campaign::CampaignResult& res, const std::string& out, bool vcd,
+                           std::optional<report::SafetyReport>* safety) {
+  if (!campaign::wants_safety_evidence(cb.spec)) return true;
+  *safety = campaign::safety_evidence(cb, res.executions, res.not_reached, res.pending, vcd);
+  for (const auto& [name, text] : {std::pair{"safety.json", report::safety_json(**safety)},
+                                   {"traceability.csv", report::traceability_csv(**safety)}}) {
+    std::string path = (std::filesystem::path(out) / name).string();
+    std::ofstream f(path, std::ios::binary);
+    f << text;
+    if (!f) {
+      std::cerr << "plcfi campaign: " << path << ": cannot write\n";
+      return false;
     }
   }
-  if (vm.count("html")) {
-    std::string dir = vm["html"].as<std::string>();
-    auto model = html_campaign_model(cb, res, out, opt.vcd);
-    model.safety = safety;
-    if (!report::write_html_report(model, dir, &err)) {
-      std::cerr << "plcfi campaign: " << err << "\n";
-      return 2;
-    }
-    std::cout << "HTML report: " << (std::filesystem::path(dir) / "index.html").string() << "\n";
+  std::cout << report::safety_text(**safety, out);
+  return true;
+}
+
+// What changed since the baseline (the folder `old`), printed; returns the regressions.
+size_t print_baseline_changes(const report::SafetyReport& baseline, const report::SafetyReport& now, const std::string& old) {
+  size_t regressions = 0;
+  auto changes = report::compare_safety(baseline, now);
+  for (const auto& ch : changes) regressions += ch.regression;
+  if (changes.empty()) {
+    std::cout << fmt::format("no change since {} (baseline)\n", old);
+  } else {
+    std::cout << fmt::format("{} change(s) since {} (baseline), {} regression(s)\n", changes.size(), old, regressions);
+    for (const auto& ch : changes) std::cout << fmt::format("  {} {}\n", ch.regression ? "REGRESSION" : "changed   ", ch.what);
   }
-  if (coverage_export_wanted(vm) &&
-      !write_coverage_exports(vm, *cb.build->app, branch_hits, cb.program_files, "campaign_" + c.name, "plcfi campaign"))
-    return 2;
+  return regressions;
+}
+
+// An execution as a JUnit test case: the verdict, what was tested and the case's facts.
+report::JunitCase junit_execution(const CampaignBuild& cb, const campaign::CampaignResult& res, const campaign::Execution& e,
+                                  const std::string& suite) {
+  const auto& tc = cb.cases[e.case_index];
+  report::JunitCase jc;
+  jc.classname = suite + "." + tc.transition_ref();
+  jc.name = fmt::format("{} path {}: {}", e.case_id, e.path, tc.row->failure_mode);
+  jc.seconds = static_cast<double>(e.end_ns - e.inject_ns) * 1e-9;
+  jc.outcome = e.outcome == campaign::Outcome::Pass ? report::JunitCase::Outcome::Pass : report::JunitCase::Outcome::Fail;
+  if (e.outcome != campaign::Outcome::Pass) jc.message = e.reason;
+  jc.detail = fmt::format("precondition: {}\nfault: {}\nexpected: {}\nresult: {}", tc.precondition, fault_text(tc),
+                          tc.expected, e.reason);
+  std::string dist;
+  for (const auto& d : campaign::distinguishing_branches(cb, res.executions, e)) dist += (dist.empty() ? "" : ", ") + d;
+  jc.properties = {{"rpn", std::to_string(tc.rpn)},
+                   {"fault_class", tc.cls->id},
+                   {"fmea", tc.row->id},
+                   {"path", std::to_string(e.path)},
+                   {"path_branches", dist},
+                   {"fault", fault_text(tc)},
+                   {"latency_ms", e.latency_ns >= 0 ? fmt::format("{:.1f}", static_cast<double>(e.latency_ns) * 1e-6) : ""},
+                   {"vcd", e.vcd}};
+  return jc;
+}
+
+// A case without an execution as a skipped JUnit test case; `message` says why.
+report::JunitCase junit_skipped(const TestCase& tc, const std::string& suite, std::string message) {
+  report::JunitCase jc;
+  jc.classname = suite + "." + tc.transition_ref();
+  jc.name = fmt::format("{}: {}", tc.id, tc.row->failure_mode);
+  jc.outcome = report::JunitCase::Outcome::Skipped;
+  jc.message = std::move(message);
+  return jc;
+}
+
+// --junit: one suite, the executions, then the cases not tested and not reached; the run's
+// figures and the safety evidence as properties. False after printing why.
+bool write_campaign_junit(const std::string& path, const CampaignBuild& cb, const Finished& f,
+                          const std::optional<report::SafetyReport>& safety) {
+  const auto& res = f.res;
+  report::JunitSuite suite;
+  suite.name = "campaign." + cb.spec.name;
+  for (const auto& e : res.executions) suite.cases.push_back(junit_execution(cb, res, e, suite.name));
+  suite.properties = res.realtime;
+  suite.properties.emplace_back("plant", cb.spec.plant);
+  for (size_t i = 0; i < f.io_report.size(); ++i) suite.properties.emplace_back(fmt::format("io_{}", i), f.io_report[i]);
+  if (res.interrupted) suite.properties.emplace_back("incomplete", res.end_reason);
+  if (safety)
+    for (auto& prop : report::safety_junit_properties(*safety)) suite.properties.push_back(std::move(prop));
+  for (size_t i : res.pending)
+    suite.cases.push_back(junit_skipped(cb.cases[i], suite.name,
+                                        "not tested: the campaign was interrupted (" + res.end_reason + "); finish it with --resume"));
+  for (size_t i : res.not_reached) {
+    const auto& tc = cb.cases[i];
+    report::JunitCase jc =
+        junit_skipped(tc, suite.name, "NOT REACHED: the precondition never held (coverage gap): " + tc.precondition);
+    jc.properties = {{"rpn", std::to_string(tc.rpn)}, {"fault_class", tc.cls->id}, {"fmea", tc.row->id}};
+    suite.cases.push_back(jc);
+  }
+  std::string err;
+  if (!report::write_junit(path, {suite}, &err)) {
+    std::cerr << "plcfi campaign: " << err << "\n";
+    return false;
+  }
+  return true;
+}
+
+// --html DIR: the report with the safety evidence. False after printing why.
+bool write_campaign_html(const std::string& dir, const CampaignBuild& cb, const campaign::CampaignResult& res,
+                         const std::string& out, bool vcd, const std::optional<report::SafetyReport>& safety) {
+  auto model = html_campaign_model(cb, res, out, vcd);
+  model.safety = safety;
+  std::string err;
+  if (!report::write_html_report(model, dir, &err)) {
+    std::cerr << "plcfi campaign: " << err << "\n";
+    return false;
+  }
+  std::cout << "HTML report: " << (std::filesystem::path(dir) / "index.html").string() << "\n";
+  return true;
+}
+
+// The reports asked for after the run: --junit, --html, --lcov and --cobertura. False after
+// printing why.
+bool write_reports(const po::variables_map& vm, const CampaignBuild& cb, const Finished& f, const std::string& out, bool vcd,
+                   const std::optional<report::SafetyReport>& safety, const std::vector<uint64_t>& branch_hits) {
+  if (vm.count("junit") && !write_campaign_junit(vm["junit"].as<std::string>(), cb, f, safety)) return false;
+  if (vm.count("html") && !write_campaign_html(vm["html"].as<std::string>(), cb, f.res, out, vcd, safety)) return false;
+  return !coverage_export_wanted(vm) ||
+         write_coverage_exports(vm, *cb.build->app, branch_hits, cb.program_files, "campaign_" + cb.spec.name, "plcfi campaign");
+}
+
+// 1 when the campaign is incomplete, got worse than the baseline (--fail-on-regression), or
+// a case failed or was not reached; else 0.
+int campaign_status(const po::variables_map& vm, const campaign::CampaignResult& res, size_t fail, size_t regressions) {
   if (res.interrupted) {
     std::cout << "campaign incomplete (" << res.end_reason << "); finish it with --resume\n";
     return 1;
@@ -612,6 +720,46 @@ int cmd_campaign(const std::vector<std::string>& args) {
     return 1;
   }
   return fail || !res.not_reached.empty() ? 1 : 0;
+}
+
+}  // namespace
+
+int cmd_campaign(const std::vector<std::string>& args) {
+  const std::string usage =
+      "plcfi campaign CAMPAIGN.yaml [--out DIR] [--resume] [--junit F] [--program FILE...] [--plant PLANT] [--seed N] [--explore] [--no-vcd] [--html DIR] [--quiet] [--io FILE --arm] [--realtime [--rt-priority N] [--cpu N]] [--jobs N | --shard K/N] [--baseline OLD_OUT [--fail-on-regression]]";
+  po::options_description desc("plcfi campaign: passive fault-injection campaign on the plant model (virtual time) or, with --io and --arm, on real I/O in real time");
+  add_campaign_options(desc);
+  po::variables_map vm;
+  if (int s = parse("campaign", usage, desc, args, &vm)) return s < 0 ? 0 : s;
+  CampaignArgs a;
+  if (!check_coverage_paths(vm, "plcfi campaign") || !split_options(vm, &a)) return 2;
+  CampaignBuild cb;
+  if (!load_with_options(vm, &cb) || !splittable(a, cb.spec)) return 2;
+  const auto& c = cb.spec;
+  a.out = out_dir(vm, c);
+  if (!read_baseline(vm, c, &a) || !prepare_outputs(vm, cb, a.out)) return 2;
+  std::cout << fmt::format("plcfi campaign {}: {} test case(s), program {}, plant {}, seed {}\n", c.name, cb.cases.size(),
+                           c.programs.back(), c.plant, c.seed);
+  a.live = !vm.count("quiet") && isatty(STDERR_FILENO);
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(*cb.build->app, "plcfi campaign"))) return 2;
+  std::vector<uint64_t> branch_hits;  // --lcov/--cobertura
+  campaign::DriverOptions opt = driver_options(vm, cb, a, native.get(), &branch_hits);
+  if (a.shard_n > 0) return run_shard(cb, a, opt);
+
+  Finished f;
+  std::optional<rt::StopSignals> signals;  // installed for real-time runs only
+  if (!run(vm, cb, a, signals, opt, &f)) return 2;
+  if (a.live) std::cerr << "\r" << std::string(72, ' ') << "\r";
+  if (f.res.resumed) std::cout << fmt::format("  resumed: {} verdict(s) read from {}/results.jsonl\n", f.res.resumed, a.out);
+  const size_t fail = print_verdict_table(cb, f.res);
+  print_totals(cb, f, fail, a.out);
+  if (c.explore.enabled && !print_suggestions(cb, f.res, a.out)) return 2;
+  std::optional<report::SafetyReport> safety;
+  if (!write_safety_evidence(cb, f.res, a.out, opt.vcd, &safety)) return 2;
+  const size_t regressions = a.baseline ? print_baseline_changes(*a.baseline, *safety, vm["baseline"].as<std::string>()) : 0;
+  if (!write_reports(vm, cb, f, a.out, opt.vcd, safety, branch_hits)) return 2;
+  return campaign_status(vm, f.res, fail, regressions);
 }
 
 }  // namespace plcfi::cli
