@@ -358,7 +358,7 @@ bool read_baseline(const po::variables_map& vm, const campaign::Campaign& c, Cam
   }
   if (!campaign::wants_safety_evidence(c)) {
     std::cerr << "plcfi campaign: --baseline compares safety evidence, and " << c.fmea.path
-              << " has no failure_rate column (see README, \"Safety evidence\")\n";
+              << " has no failure_rate column (see docs/pages/reports/safety.md)\n";
     return false;
   }
   std::string path = (std::filesystem::path(vm["baseline"].as<std::string>()) / "safety.json").string(), text, err;
