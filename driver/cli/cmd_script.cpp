@@ -235,15 +235,8 @@ script::HistoryRow history_row(const script::Script& s, const script::ScriptResu
   return row;
 }
 
-}  // namespace
-
-int cmd_script(const std::vector<std::string>& args) {
-  const std::string usage =
-      "plcfi script PROGRAM.st... TEST.cpt... [--plant stamping|bead_dispenser | --io FILE] [--realtime] [--history FILE] "
-      "[--log DIR] [--junit F] [--filter GLOB] [--list] [--test-timeout D] [--timeout D] [--link-fault [DEVICE=]AT:FOR] "
-      "[--max-wait 1s] [--alpha A --beta B --gamma G --psi P --n N]";
-  po::options_description desc(
-      "plcfi script: CPTest+ test scripts against a PLC program, on a plant model in virtual time or on bench I/O in real time");
+// The options of `plcfi script`.
+void add_script_options(po::options_description& desc) {
   desc.add_options()
       ("plant", po::value<std::string>(), "plant model (stamping, bead_dispenser; default stamping)")
       ("io", po::value<std::string>(), "run on bench I/O instead (a file with an io: section), paced in real time")
@@ -267,267 +260,435 @@ int cmd_script(const std::vector<std::string>& args) {
       ("psi", po::value<IntIn<1, 1000000>>()->default_value(IntIn<1, 1000000>{10}, "10"), "m_ci: latest runs counted for p_lst")
       ("n", po::value<double>()->default_value(1.0, "1"), "m_ci: shape of the fall from beta to alpha (1: linear)")
       ("native", "run the program through the native tier");
-  po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, usage)) return 0;
-  std::vector<std::string> programs, scripts;
-  for (const auto& f : strings_of(vm, "files")) (ends_with(f, ".cpt") ? scripts : programs).push_back(f);
-  if (programs.empty() || scripts.empty()) {
-    std::cerr << "plcfi script: expected the program's ST files and one or more .cpt scripts\nusage: " << usage << "\n";
-    return 2;
-  }
-  Selection sel;
-  if (!selection_of(vm, &sel)) return 2;
-  std::string err;
-  script::RunOptions ro;
-  ro.mci.alpha = number_option(vm, "alpha");
-  ro.mci.beta = number_option(vm, "beta");
-  ro.mci.gamma = vm["gamma"].as<IntIn<2, 1000000>>().value;
-  ro.mci.psi = vm["psi"].as<IntIn<1, 1000000>>().value;
-  ro.mci.n = number_option(vm, "n");
-  if (std::string e = script::check_params(ro.mci); !e.empty()) {
-    std::cerr << "plcfi script: " << e << "\n";
-    return 2;
-  }
-  if (!rt::parse_duration(vm["max-wait"].as<std::string>(), &ro.max_wait_ns, &err)) {
-    std::cerr << "plcfi script: --max-wait: " << err << "\n";
-    return 2;
-  }
-  int64_t fault_at = -1, fault_for = 0;
-  std::string fault_device;
-  if (vm.count("link-fault")) {
-    std::string v = vm["link-fault"].as<std::string>();
-    if (size_t eq = v.find('='); eq != std::string::npos) {
-      fault_device = v.substr(0, eq);
-      v = v.substr(eq + 1);
-    }
-    size_t colon = v.find(':');
-    if (colon == std::string::npos || !rt::parse_duration(v.substr(0, colon), &fault_at, &err) ||
-        !rt::parse_duration(v.substr(colon + 1), &fault_for, &err) || fault_for <= 0) {
-      std::cerr << "plcfi script: --link-fault: expected [DEVICE=]AT:FOR with two durations, e.g. 100ms:300ms"
-                << (err.empty() ? "" : " (" + err + ")") << ", got '" << vm["link-fault"].as<std::string>() << "'\n";
-      return 2;
-    }
-  }
+}
 
-  // Everything is read and checked before anything runs.
+// The command line of `plcfi script`, checked.
+struct ScriptArgs {
+  std::vector<std::string> programs, scripts;
+  Selection sel;
+  script::RunOptions ro;                 // m_ci and --max-wait; per script, its time limit and p_lst
+  int64_t fault_at = -1, fault_for = 0;  // --link-fault; fault_at -1: none
+  std::string fault_device;
+};
+
+// The plain arguments: the program's ST files and the .cpt scripts. False after printing
+// the usage.
+bool split_files(const po::variables_map& vm, const std::string& usage, ScriptArgs* a) {
+  for (const auto& f : strings_of(vm, "files")) (ends_with(f, ".cpt") ? a->scripts : a->programs).push_back(f);
+  if (a->programs.empty() || a->scripts.empty()) {
+    std::cerr << "plcfi script: expected the program's ST files and one or more .cpt scripts\nusage: " << usage << "\n";
+    return false;
+  }
+  return true;
+}
+
+// m_ci's parameters and --max-wait: how ASSERT_COM waits through a communication error.
+// False after printing why.
+bool wait_options(const po::variables_map& vm, script::RunOptions* ro) {
+  ro->mci.alpha = number_option(vm, "alpha");
+  ro->mci.beta = number_option(vm, "beta");
+  ro->mci.gamma = vm["gamma"].as<IntIn<2, 1000000>>().value;
+  ro->mci.psi = vm["psi"].as<IntIn<1, 1000000>>().value;
+  ro->mci.n = number_option(vm, "n");
+  if (std::string e = script::check_params(ro->mci); !e.empty()) {
+    std::cerr << "plcfi script: " << e << "\n";
+    return false;
+  }
+  std::string err;
+  if (!rt::parse_duration(vm["max-wait"].as<std::string>(), &ro->max_wait_ns, &err)) {
+    std::cerr << "plcfi script: --max-wait: " << err << "\n";
+    return false;
+  }
+  return true;
+}
+
+// --link-fault [DEVICE=]AT:FOR. False after printing why.
+bool link_fault_option(const po::variables_map& vm, ScriptArgs* a) {
+  if (!vm.count("link-fault")) return true;
+  std::string v = vm["link-fault"].as<std::string>(), err;
+  if (size_t eq = v.find('='); eq != std::string::npos) {
+    a->fault_device = v.substr(0, eq);
+    v = v.substr(eq + 1);
+  }
+  size_t colon = v.find(':');
+  if (colon == std::string::npos || !rt::parse_duration(v.substr(0, colon), &a->fault_at, &err) ||
+      !rt::parse_duration(v.substr(colon + 1), &a->fault_for, &err) || a->fault_for <= 0) {
+    std::cerr << "plcfi script: --link-fault: expected [DEVICE=]AT:FOR with two durations, e.g. 100ms:300ms"
+              << (err.empty() ? "" : " (" + err + ")") << ", got '" << vm["link-fault"].as<std::string>() << "'\n";
+    return false;
+  }
+  return true;
+}
+
+bool script_args(const po::variables_map& vm, const std::string& usage, ScriptArgs* a) {
+  return split_files(vm, usage, a) && selection_of(vm, &a->sel) && wait_options(vm, &a->ro) && link_fault_option(vm, a);
+}
+
+// The program, compiled, its diagnostics on stderr. Null when it does not compile.
+std::unique_ptr<st::Build> compile_program(const po::variables_map& vm, const std::vector<std::string>& programs) {
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
   opt.warnings = false;
   auto b = st::build_files(programs, opt);
   for (const auto& e : b->io_errors) std::cerr << e << "\n";
   std::cerr << b->diags.render_all();
-  if (!b->ok()) return 2;
-  const st::Application& app = *b->app;
-  std::vector<script::Script> parsed(scripts.size());
-  std::vector<script::BoundScript> bound(scripts.size());
+  if (!b->ok()) return nullptr;
+  return b;
+}
+
+bool load_scripts(const std::vector<std::string>& scripts, std::vector<script::Script>* parsed) {
+  parsed->resize(scripts.size());
+  std::string err;
   for (size_t i = 0; i < scripts.size(); ++i) {
-    if (!script::load_script(scripts[i], &parsed[i], &err)) {
+    if (!script::load_script(scripts[i], &(*parsed)[i], &err)) {
       std::cerr << err << "\n";
-      return 2;
+      return false;
     }
   }
+  return true;
+}
+
+// The configuration's tasks, or the program alone every --cycle-time.
+bool script_schedule(const po::variables_map& vm, const st::Application& app, rt::Schedule* sched) {
   int64_t cycle = 0;
+  std::string err;
   if (!rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
     std::cerr << "plcfi script: --cycle-time: " << err << "\n";
-    return 2;
+    return false;
   }
-  rt::Schedule sched;
-  if (!(app.has_configuration ? sched.from_configuration(app, &err) : sched.single_program(app, "", cycle, &err))) {
+  if (!(app.has_configuration ? sched->from_configuration(app, &err) : sched->single_program(app, "", cycle, &err))) {
     std::cerr << "plcfi script: " << err << "\n";
-    return 2;
+    return false;
   }
-  const bool bench = vm.count("io") > 0;
-  if (bench && (vm.count("plant") || vm.count("plant-config") || vm.count("link-status"))) {
-    std::cerr << "plcfi script: --io runs on the bench's devices; --plant, --plant-config and --link-status are for the plant model\n";
-    return 2;
-  }
-  // Offline: the plant model behind a link that can be broken. On a bench: the devices of
-  // the io file, each of which can be.
+  return true;
+}
+
+// Where the scripts run. Offline: the plant model behind a link that can be broken. On a
+// bench: the devices of the io file, each of which can be.
+struct Target {
   std::unique_ptr<io::SimBackend> sim;
   std::unique_ptr<io::LinkFaultBackend> link;
   std::unique_ptr<io::BenchIo> bench_io;
   io::IoConfig cfg;
   std::string where;  // the plant, or the io file
   rt::IoBackend* backend = nullptr;
-  if (bench) {
-    if (!io::load_io_config(vm["io"].as<std::string>(), app, &cfg, &err) || !(bench_io = io::BenchIo::open(cfg, sched.tick_ns(), &err))) {
+};
+
+bool open_bench(const po::variables_map& vm, const st::Application& app, const rt::Schedule& sched, Target* t) {
+  std::string err;
+  if (!io::load_io_config(vm["io"].as<std::string>(), app, &t->cfg, &err) ||
+      !(t->bench_io = io::BenchIo::open(t->cfg, sched.tick_ns(), &err))) {
+    std::cerr << err << "\n";
+    return false;
+  }
+  t->backend = t->bench_io.get();
+  t->where = "bench I/O " + t->cfg.path;
+  return true;
+}
+
+// --link-status: the %IX bit that reads TRUE while the link works, into *status.
+bool link_status_option(const po::variables_map& vm, const st::Application& app, std::optional<rt::ImageRef>* status) {
+  if (!vm.count("link-status")) return true;
+  rt::ImageRef ref;
+  std::string err;
+  if (!rt::parse_image_ref(app, vm["link-status"].as<std::string>(), &ref, &err) || ref.area != 'I' || !ref.is_bit) {
+    std::cerr << "plcfi script: --link-status: " << (err.empty() ? "expected an input bit such as %IX1.0" : err) << "\n";
+    return false;
+  }
+  *status = ref;
+  return true;
+}
+
+bool open_plant_link(const po::variables_map& vm, const st::Application& app, Target* t) {
+  std::string err;
+  auto plant = io::open_plant(vm.count("plant") ? vm["plant"].as<std::string>() : "stamping",
+                              vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
+  if (!plant) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return false;
+  }
+  t->where = "plant " + plant->name() + (plant->origin().empty() ? "" : " (" + plant->origin() + ")");
+  if (!(t->sim = io::SimBackend::create(app, std::move(plant), &err))) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return false;
+  }
+  std::optional<rt::ImageRef> status;
+  if (!link_status_option(vm, app, &status)) return false;
+  t->link = std::make_unique<io::LinkFaultBackend>(t->sim.get(), "plant", status);
+  t->backend = t->link.get();
+  return true;
+}
+
+// The bench's devices (--io) or the plant model (--plant). False after printing why.
+bool open_target(const po::variables_map& vm, const st::Application& app, const rt::Schedule& sched, Target* t) {
+  const bool bench = vm.count("io") > 0;
+  if (bench && (vm.count("plant") || vm.count("plant-config") || vm.count("link-status"))) {
+    std::cerr << "plcfi script: --io runs on the bench's devices; --plant, --plant-config and --link-status are for the plant model\n";
+    return false;
+  }
+  return bench ? open_bench(vm, app, sched, t) : open_plant_link(vm, app, t);
+}
+
+// The scripts' names resolved in the program and among the link's devices.
+bool bind_scripts(const st::Application& app, const std::vector<script::Script>& parsed, const std::vector<std::string>& devices,
+                  std::vector<script::BoundScript>* bound) {
+  bound->resize(parsed.size());
+  std::string err;
+  for (size_t i = 0; i < parsed.size(); ++i) {
+    if (!script::bind_script(app, parsed[i], devices, &(*bound)[i], &err)) {
       std::cerr << err << "\n";
-      return 2;
-    }
-    backend = bench_io.get();
-    where = "bench I/O " + cfg.path;
-  } else {
-    auto plant = io::open_plant(vm.count("plant") ? vm["plant"].as<std::string>() : "stamping",
-                                   vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
-    if (!plant) {
-      std::cerr << "plcfi script: " << err << "\n";
-      return 2;
-    }
-    where = "plant " + plant->name() + (plant->origin().empty() ? "" : " (" + plant->origin() + ")");
-    if (!(sim = io::SimBackend::create(app, std::move(plant), &err))) {
-      std::cerr << "plcfi script: " << err << "\n";
-      return 2;
-    }
-    std::optional<rt::ImageRef> status;
-    if (vm.count("link-status")) {
-      rt::ImageRef ref;
-      if (!rt::parse_image_ref(app, vm["link-status"].as<std::string>(), &ref, &err) || ref.area != 'I' || !ref.is_bit) {
-        std::cerr << "plcfi script: --link-status: " << (err.empty() ? "expected an input bit such as %IX1.0" : err) << "\n";
-        return 2;
-      }
-      status = ref;
-    }
-    link = std::make_unique<io::LinkFaultBackend>(sim.get(), "plant", status);
-    backend = link.get();
-  }
-  const std::vector<std::string> devices = backend->link_devices();
-  for (size_t i = 0; i < scripts.size(); ++i) {
-    if (!script::bind_script(app, parsed[i], devices, &bound[i], &err)) {
-      std::cerr << err << "\n";
-      return 2;
+      return false;
     }
   }
-  if (fault_at >= 0) {
-    if (fault_device.empty() && !devices.empty()) fault_device = devices.front();
-    bool known = false;
-    for (const auto& d : devices) known = known || d == fault_device;
-    if (!known) {
-      std::string list;
-      for (const auto& d : devices) list += (list.empty() ? "" : ", ") + d;
-      std::cerr << "plcfi script: --link-fault: unknown device '" << fault_device << "' (known: " << (list.empty() ? "none" : list) << ")\n";
-      return 2;
-    }
+  return true;
+}
+
+// The device --link-fault breaks: the one named, else the first. False when it is unknown.
+bool link_fault_device(const std::vector<std::string>& devices, ScriptArgs* a) {
+  if (a->fault_at < 0) return true;
+  if (a->fault_device.empty() && !devices.empty()) a->fault_device = devices.front();
+  bool known = false;
+  for (const auto& d : devices) known = known || d == a->fault_device;
+  if (!known) {
+    std::string list;
+    for (const auto& d : devices) list += (list.empty() ? "" : ", ") + d;
+    std::cerr << "plcfi script: --link-fault: unknown device '" << a->fault_device << "' (known: " << (list.empty() ? "none" : list) << ")\n";
+    return false;
   }
-  const std::vector<size_t> chosen = selected_scripts(parsed, sel.filter);
-  // A --filter that selects nothing is a mistake (a misspelt name), not a green run.
-  if (chosen.empty()) {
-    std::cerr << "plcfi script: --filter selects none of the " << scripts.size() << " script(s): --list shows them (PATH/TEST)\n";
+  return true;
+}
+
+// The scripts --filter selects, into *chosen. With --list they are printed, not run: 0.
+// A --filter that selects nothing is a mistake (a misspelt name), not a green run: 2.
+// Else -1: run them.
+int choose_scripts(const Selection& sel, const std::vector<script::Script>& parsed, std::vector<size_t>* chosen) {
+  *chosen = selected_scripts(parsed, sel.filter);
+  if (chosen->empty()) {
+    std::cerr << "plcfi script: --filter selects none of the " << parsed.size() << " script(s): --list shows them (PATH/TEST)\n";
     return 2;
   }
   if (sel.list) {  // what would run, without running it
-    for (size_t i : chosen) std::cout << parsed[i].path << "/" << parsed[i].name << "\n";
+    for (size_t i : *chosen) std::cout << parsed[i].path << "/" << parsed[i].name << "\n";
     return 0;
   }
-  rt::Runtime runtime(app, sched, backend);
-  if (bench) runtime.set_safe_state(cfg.safe_state);
-  // Every way out once the devices are open: the safe output state reaches them first.
-  struct SafeExit {
-    rt::Runtime& rt;
-    io::BenchIo* io;
-    ~SafeExit() {
-      if (!io) return;
-      rt.write_safe_outputs();
-      io->close();
+  return -1;
+}
+
+// Every way out once the devices are open: the safe output state reaches them first.
+struct SafeExit {
+  rt::Runtime& rt;
+  io::BenchIo* io;
+  ~SafeExit() {
+    if (!io) return;
+    rt.write_safe_outputs();
+    io->close();
+  }
+};
+
+std::unique_ptr<script::History> open_history(const std::string& path) {
+  std::string err;
+  auto history = script::History::open(path, &err);
+  if (!history) std::cerr << "plcfi script: " << err << "\n";
+  return history;
+}
+
+// --log DIR, created. False after printing why.
+bool make_log_dir(const std::string& log_dir) {
+  if (log_dir.empty()) return true;
+  std::error_code ec;
+  std::filesystem::create_directories(log_dir, ec);
+  if (ec) {
+    std::cerr << "plcfi script: --log: " << log_dir << ": " << ec.message() << "\n";
+    return false;
+  }
+  return true;
+}
+
+// Paced on a bench (or offline with --realtime): the real-time loop watches signals and
+// lost devices; a way out it takes ends the run undecidable, with its reason. Null when the
+// runs are not paced.
+std::unique_ptr<rt::ScanLoop> paced_loop(bool paced, rt::Runtime& runtime, const rt::StopSignals& signals,
+                                         io::BenchIo* bench_io, script::RunOptions* ro) {
+  if (!paced) return nullptr;
+  auto loop = std::make_unique<rt::ScanLoop>(runtime, true, &signals, [bench_io] { return bench_io ? bench_io->lost() : std::string(); });
+  ro->scan = [l = loop.get()](rt::Runtime&, std::string* why) {
+    if (l->check_stop() != rt::LoopEnd::None) {
+      *why = l->end_reason();
+      return false;
     }
-  } safe_exit{runtime, bench_io.get()};
+    l->scan();
+    return true;
+  };
+  return loop;
+}
+
+// What the runs of the scripts share.
+struct Session {
+  const st::Build& b;
+  rt::Runtime& runtime;
+  rt::IoBackend& backend;
+  script::History& history;
+  ScriptArgs& a;  // a.ro changes per script
+  const std::string& log_dir;
+  const std::string prog_hash;
+  const uint64_t seed;
+  rt::ScanLoop* loop = nullptr;  // paced runs only
+};
+
+// A script the run's time-out left no time for: failed without running.
+void fail_not_started(const Selection& sel, const script::Script& s, testing::TestSuite* suite) {
+  testing::TestCase& c = suite->cases.back();
+  c.verdict = testing::Verdict::Fail;
+  c.findings.push_back({"", not_started(sel)});
+  std::cout << fmt::format("\n[{}] Failed  (not run)\n  {}\n", s.path, c.findings.back().text);
+}
+
+// The script's run. With --log, its waveform: every scan of the run, the variables a
+// snapshot records that a VCD can show, into LOG/TEST.vcd. False after printing why.
+bool run_traced(const Session& x, const script::Script& s, const script::BoundScript& bound, script::ScriptResult* r) {
+  std::unique_ptr<report::TraceWriter> vcd;
+  std::unique_ptr<TraceHook> vcd_hook;
+  std::string err;
+  if (!x.log_dir.empty()) {
+    std::vector<st::VarHandle> traced;
+    for (const auto& v : script::snapshot_variables(*x.b.app))
+      if (v.is_bit || v.type->is_elementary()) traced.push_back(v);
+    if (!(vcd = report::open_vcd(x.log_dir + "/" + s.name + ".vcd", traced, &err))) {
+      std::cerr << "plcfi script: --log: " << err << "\n";
+      return false;
+    }
+    vcd_hook = std::make_unique<TraceHook>(std::vector<report::TraceWriter*>{vcd.get()});
+    x.runtime.add_hooks(vcd_hook.get());
+  }
+  *r = script::run_script(x.runtime, bound, x.a.ro);
+  if (vcd) {
+    x.runtime.remove_hooks(vcd_hook.get());
+    if (!vcd->close(&err)) {
+      std::cerr << "plcfi script: --log: " << err << "\n";
+      return false;
+    }
+  }
+  return true;
+}
+
+// --log: the run's text log LOG/TEST.log and its snapshots LOG/TEST.csv.
+bool write_logs(const std::string& log_dir, const script::Script& s, const script::ScriptResult& r) {
+  if (log_dir.empty()) return true;
+  std::string err;
+  if (!write_text_log(log_dir + "/" + s.name + ".log", r, &err) || !write_csv_log(log_dir + "/" + s.name + ".csv", r, &err)) {
+    std::cerr << "plcfi script: --log: " << err << "\n";
+    return false;
+  }
+  return true;
+}
+
+// One script from a cold restart (the link broken as --link-fault says): run, printed,
+// recorded in the history and the logs, its test case into `suite`. False after printing
+// why.
+bool run_one(const Session& x, const script::Script& s, const script::BoundScript& bound, int64_t* used_ns,
+             testing::TestSuite* suite) {
+  script::RunOptions& ro = x.a.ro;
+  std::string err;
+  std::vector<std::string> pous;
+  const std::string pou_hash = script::involved_pous_hash(x.b, bound.var_paths, &pous);
+  if (!x.history.passes_since_change(s.name, pou_hash, ro.mci.psi, &ro.p_lst, &err)) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return false;
+  }
+  x.runtime.cold_restart(x.seed);
+  if (x.a.fault_at >= 0) x.backend.break_link(x.a.fault_device, x.runtime.now() + x.a.fault_at, x.a.fault_for);
+  if (x.loop) x.loop->start();
+  const uint64_t failed_before = x.backend.failed_exchanges();
+  script::ScriptResult r;
+  if (!run_traced(x, s, bound, &r)) return false;
+  *used_ns += r.end_ns;
+  print_run(s, r, pous, ro, x.backend.failed_exchanges() - failed_before);
+  const script::HistoryRow row = history_row(s, r, x.prog_hash, pou_hash);
+  if (!x.history.add(row, &err)) {
+    std::cerr << "plcfi script: " << err << "\n";
+    return false;
+  }
+  if (!write_logs(x.log_dir, s, r)) return false;
+  suite->cases.back() = script_case(s, r, row, ro.p_lst);
+  return true;
+}
+
+// The chosen scripts one after another until a stop signal, each a suite in `suites`.
+// False after printing why.
+bool run_scripts(const Session& x, const std::vector<size_t>& chosen, const std::vector<script::Script>& parsed,
+                 const std::vector<script::BoundScript>& bound,
+                 const std::vector<std::pair<std::string, std::string>>& run_props, const rt::StopSignals& signals,
+                 std::vector<testing::TestSuite>* suites) {
+  int64_t used_ns = 0;  // the scan clock of the scripts run so far (--timeout)
+  for (size_t i : chosen) {
+    suites->push_back(script_suite(parsed[i], run_props));
+    if (!limit_time(x.a.sel, used_ns, &x.a.ro)) {
+      fail_not_started(x.a.sel, parsed[i], &suites->back());
+      continue;
+    }
+    if (!run_one(x, parsed[i], bound[i], &used_ns, &suites->back())) return false;
+    if (signals.requested()) break;
+  }
+  return true;
+}
+
+}  // namespace
+
+int cmd_script(const std::vector<std::string>& args) {
+  const std::string usage =
+      "plcfi script PROGRAM.st... TEST.cpt... [--plant stamping|bead_dispenser | --io FILE] [--realtime] [--history FILE] "
+      "[--log DIR] [--junit F] [--filter GLOB] [--list] [--test-timeout D] [--timeout D] [--link-fault [DEVICE=]AT:FOR] "
+      "[--max-wait 1s] [--alpha A --beta B --gamma G --psi P --n N]";
+  po::options_description desc(
+      "plcfi script: CPTest+ test scripts against a PLC program, on a plant model in virtual time or on bench I/O in real time");
+  add_script_options(desc);
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm, usage)) return 0;
+  ScriptArgs a;
+  if (!script_args(vm, usage, &a)) return 2;
+
+  // Everything is read and checked before anything runs.
+  auto b = compile_program(vm, a.programs);
+  if (!b) return 2;
+  const st::Application& app = *b->app;
+  std::vector<script::Script> parsed;
+  rt::Schedule sched;
+  Target t;
+  if (!load_scripts(a.scripts, &parsed) || !script_schedule(vm, app, &sched) || !open_target(vm, app, sched, &t)) return 2;
+  const std::vector<std::string> devices = t.backend->link_devices();
+  std::vector<script::BoundScript> bound;
+  if (!bind_scripts(app, parsed, devices, &bound) || !link_fault_device(devices, &a)) return 2;
+  std::vector<size_t> chosen;
+  if (int s = choose_scripts(a.sel, parsed, &chosen); s >= 0) return s;
+  rt::Runtime runtime(app, sched, t.backend);
+  if (t.bench_io) runtime.set_safe_state(t.cfg.safe_state);
+  SafeExit safe_exit{runtime, t.bench_io.get()};
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi script"))) return 2;
   runtime.machine().set_native(native.get());
   const std::string history_path = vm.count("history") ? vm["history"].as<std::string>() : script::default_history_path();
-  auto history = script::History::open(history_path, &err);
-  if (!history) {
-    std::cerr << "plcfi script: " << err << "\n";
-    return 2;
-  }
-  std::string log_dir = vm.count("log") ? vm["log"].as<std::string>() : "";
-  if (!log_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(log_dir, ec);
-    if (ec) {
-      std::cerr << "plcfi script: --log: " << log_dir << ": " << ec.message() << "\n";
-      return 2;
-    }
-  }
+  auto history = open_history(history_path);
+  if (!history) return 2;
+  const std::string log_dir = vm.count("log") ? vm["log"].as<std::string>() : "";
+  if (!make_log_dir(log_dir)) return 2;
 
   rt::StopSignals signals;
-  ro.signals = &signals;
-  const std::string prog_hash = script::program_hash(*b);
-  const uint64_t seed = vm["seed"].as<Count>().value;
-  const std::vector<std::pair<std::string, std::string>> run_props = {{"io", where}, {"history", history_path}};
+  a.ro.signals = &signals;
+  Session x{*b, runtime, *t.backend, *history, a, log_dir, script::program_hash(*b), vm["seed"].as<Count>().value, nullptr};
+  std::cout << fmt::format("plcfi script: {} on {}, history {}\n", a.programs.front(), t.where, history_path);
+  auto loop = paced_loop(t.bench_io || vm.count("realtime"), runtime, signals, t.bench_io.get(), &a.ro);
+  x.loop = loop.get();
   std::vector<testing::TestSuite> suites;
-  int64_t used_ns = 0;  // the scan clock of the scripts run so far (--timeout)
-  std::cout << fmt::format("plcfi script: {} on {}, history {}\n", programs.front(), where, history_path);
-  // Paced on a bench (or offline with --realtime): the real-time loop watches signals and
-  // lost devices; a way out it takes ends the run undecidable, with its reason.
-  std::unique_ptr<rt::ScanLoop> loop;
-  if (bench || vm.count("realtime")) {
-    loop = std::make_unique<rt::ScanLoop>(runtime, true, &signals, [&bench_io] { return bench_io ? bench_io->lost() : std::string(); });
-    ro.scan = [&loop](rt::Runtime&, std::string* why) {
-      if (loop->check_stop() != rt::LoopEnd::None) {
-        *why = loop->end_reason();
-        return false;
-      }
-      loop->scan();
-      return true;
-    };
-  }
-  for (size_t i : chosen) {
-    const script::Script& s = parsed[i];
-    suites.push_back(script_suite(s, run_props));
-    if (!limit_time(sel, used_ns, &ro)) {
-      testing::TestCase& c = suites.back().cases.back();
-      c.verdict = testing::Verdict::Fail;
-      c.findings.push_back({"", not_started(sel)});
-      std::cout << fmt::format("\n[{}] Failed  (not run)\n  {}\n", s.path, c.findings.back().text);
-      continue;
-    }
-    std::vector<std::string> pous;
-    const std::string pou_hash = script::involved_pous_hash(*b, bound[i].var_paths, &pous);
-    if (!history->passes_since_change(s.name, pou_hash, ro.mci.psi, &ro.p_lst, &err)) {
-      std::cerr << "plcfi script: " << err << "\n";
-      return 2;
-    }
-    runtime.cold_restart(seed);
-    if (fault_at >= 0) backend->break_link(fault_device, runtime.now() + fault_at, fault_for);
-    if (loop) loop->start();
-    // The log's waveform: every scan of the run, the variables a snapshot records that a
-    // VCD can show.
-    std::unique_ptr<report::TraceWriter> vcd;
-    std::unique_ptr<TraceHook> vcd_hook;
-    if (!log_dir.empty()) {
-      std::vector<st::VarHandle> traced;
-      for (const auto& v : script::snapshot_variables(app))
-        if (v.is_bit || v.type->is_elementary()) traced.push_back(v);
-      if (!(vcd = report::open_vcd(log_dir + "/" + s.name + ".vcd", traced, &err))) {
-        std::cerr << "plcfi script: --log: " << err << "\n";
-        return 2;
-      }
-      vcd_hook = std::make_unique<TraceHook>(std::vector<report::TraceWriter*>{vcd.get()});
-      runtime.add_hooks(vcd_hook.get());
-    }
-    const uint64_t failed_before = backend->failed_exchanges();
-    script::ScriptResult r = script::run_script(runtime, bound[i], ro);
-    used_ns += r.end_ns;
-    if (vcd) {
-      runtime.remove_hooks(vcd_hook.get());
-      if (!vcd->close(&err)) {
-        std::cerr << "plcfi script: --log: " << err << "\n";
-        return 2;
-      }
-    }
-    print_run(s, r, pous, ro, backend->failed_exchanges() - failed_before);
-    const script::HistoryRow row = history_row(s, r, prog_hash, pou_hash);
-    if (!history->add(row, &err)) {
-      std::cerr << "plcfi script: " << err << "\n";
-      return 2;
-    }
-    if (!log_dir.empty()) {
-      if (!write_text_log(log_dir + "/" + s.name + ".log", r, &err) || !write_csv_log(log_dir + "/" + s.name + ".csv", r, &err)) {
-        std::cerr << "plcfi script: --log: " << err << "\n";
-        return 2;
-      }
-    }
-    suites.back().cases.back() = script_case(s, r, row, ro.p_lst);
-    if (signals.requested()) break;
-  }
-  const testing::Totals t = testing::totals(suites);
-  std::cout << fmt::format("\n{} passed, {} failed, {} undecidable\n", t.passed, t.failed, t.undecidable);
+  if (!run_scripts(x, chosen, parsed, bound, {{"io", t.where}, {"history", history_path}}, signals, &suites)) return 2;
+  const testing::Totals totals = testing::totals(suites);
+  std::cout << fmt::format("\n{} passed, {} failed, {} undecidable\n", totals.passed, totals.failed, totals.undecidable);
+  std::string err;
   if (vm.count("junit") && !report::write_test_junit(vm["junit"].as<std::string>(), suites, &err)) {
     std::cerr << "plcfi script: " << err << "\n";
     return 2;
   }
-  return t.failed > 0 ? 1 : 0;
+  return totals.failed > 0 ? 1 : 0;
 }
 
 int cmd_history(const std::vector<std::string>& args) {
