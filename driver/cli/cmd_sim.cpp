@@ -108,10 +108,8 @@ bool is_alarm_name(const std::string& name) {
   return false;
 }
 
-}  // namespace
-
-int cmd_sim(const std::vector<std::string>& args) {
-  po::options_description desc("plcfi sim: run a PLC program on a plant model in virtual time");
+// The options of `plcfi sim`.
+void add_sim_options(po::options_description& desc) {
   desc.add_options()
       ("program", po::value<std::vector<std::string>>()->multitoken(), "ST files of the program (also accepted as plain arguments)")
       ("plant", po::value<std::string>()->default_value("stamping"), "plant model")
@@ -126,197 +124,299 @@ int cmd_sim(const std::vector<std::string>& args) {
       ("requirements", po::value<std::string>(), "EDTL requirements (YAML) checked every scan")
       ("native", "run the program (and the monitors) through the native tier");
   add_coverage_export_options(desc);
-  po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm,
-                  "plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
-                  "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml] [--lcov F] [--cobertura F]"))
-    return 0;
-  if (!check_coverage_paths(vm, "plcfi sim")) return 2;
+}
+
+// --program and the plain arguments: the program's ST files.
+std::vector<std::string> program_files(const po::variables_map& vm) {
   std::vector<std::string> files;
   if (vm.count("program")) files = vm["program"].as<std::vector<std::string>>();
   if (vm.count("files"))
     for (const auto& f : vm["files"].as<std::vector<std::string>>()) files.push_back(f);
-  if (files.empty()) {
-    std::cerr << "plcfi sim: no program files (--program FILE...)\n";
-    return 2;
-  }
-  std::string err;
+  return files;
+}
+
+// --requirements: the EDTL requirements and their monitors' ST source, compiled with the
+// program (late: none without --requirements).
+struct Requirements {
   monitor::RequirementsFile reqs;
   monitor::MonitorSource mon;
   st::GeneratedSources late;
-  if (vm.count("requirements")) {
-    if (!monitor::load_requirements(vm["requirements"].as<std::string>(), &reqs, &err)) {
-      std::cerr << err << "\n";
-      return 2;
-    }
-    mon = monitor::generate_monitors(reqs);
-    late.push_back(mon.source(reqs.path));
+};
+
+bool load_requirements_of(const po::variables_map& vm, Requirements* r) {
+  if (!vm.count("requirements")) return true;
+  std::string err;
+  if (!monitor::load_requirements(vm["requirements"].as<std::string>(), &r->reqs, &err)) {
+    std::cerr << err << "\n";
+    return false;
   }
+  r->mon = monitor::generate_monitors(r->reqs);
+  r->late.push_back(r->mon.source(r->reqs.path));
+  return true;
+}
+
+// The program (with the monitors), compiled, its diagnostics on stderr. Null when it does
+// not compile.
+std::unique_ptr<st::Build> compile_program(const po::variables_map& vm, const std::vector<std::string>& files,
+                                           const st::GeneratedSources& late) {
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
   opt.warnings = false;
   auto b = st::build_files(files, opt, late);
   for (const auto& e : b->io_errors) std::cerr << e << "\n";
   std::cerr << b->diags.render_all();
-  if (!b->ok()) return 2;
-  const st::Application& app = *b->app;
-  int64_t duration = 0, cycle = 0;
-  if (!rt::parse_duration(vm["duration"].as<std::string>(), &duration, &err) || duration <= 0) {
+  if (!b->ok()) return nullptr;
+  return b;
+}
+
+// --duration, and the schedule: the configuration's tasks, or the program alone every
+// --cycle-time. False after printing why.
+bool sim_timing(const po::variables_map& vm, const st::Application& app, int64_t* duration, rt::Schedule* sched) {
+  int64_t cycle = 0;
+  std::string err;
+  if (!rt::parse_duration(vm["duration"].as<std::string>(), duration, &err) || *duration <= 0) {
     std::cerr << "plcfi sim: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
-    return 2;
+    return false;
   }
   if (!rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
     std::cerr << "plcfi sim: --cycle-time: " << err << "\n";
-    return 2;
+    return false;
   }
-  rt::Schedule sched;
-  bool ok = app.has_configuration ? sched.from_configuration(app, &err) : sched.single_program(app, "", cycle, &err);
+  bool ok = app.has_configuration ? sched->from_configuration(app, &err) : sched->single_program(app, "", cycle, &err);
   if (!ok) {
     std::cerr << "plcfi sim: " << err << "\n";
-    return 2;
+    return false;
   }
+  return true;
+}
+
+// The plant model (--plant, --plant-config) behind the program's I/O. Null after printing
+// why.
+std::unique_ptr<io::SimBackend> open_sim(const po::variables_map& vm, const st::Application& app) {
+  std::string err;
   auto plant = io::open_plant(vm["plant"].as<std::string>(), vm.count("plant-config") ? vm["plant-config"].as<std::string>() : "", &err);
   if (!plant) {
     std::cerr << "plcfi sim: " << err << "\n";
-    return 2;
+    return nullptr;
   }
   auto backend = io::SimBackend::create(app, std::move(plant), &err);
-  if (!backend) {
+  if (!backend) std::cerr << "plcfi sim: " << err << "\n";
+  return backend;
+}
+
+// The variables a list option (--alarms, --watch) names. False after printing why.
+bool resolve_named(const po::variables_map& vm, const char* key, const st::Application& app, std::vector<st::VarHandle>* out) {
+  std::string err;
+  for (const auto& p : split_list(vm[key].as<std::vector<std::string>>())) {
+    auto h = st::resolve(app, p, &err);
+    if (!h) {
+      std::cerr << "plcfi sim: --" << key << ": " << err << "\n";
+      return false;
+    }
+    out->push_back(*h);
+  }
+  return true;
+}
+
+// --alarms, else the BOOL globals named like alarms.
+bool alarm_vars(const po::variables_map& vm, const st::Application& app, std::vector<st::VarHandle>* alarms) {
+  if (vm.count("alarms")) return resolve_named(vm, "alarms", app, alarms);
+  std::string err;
+  for (const auto& g : app.globals)
+    if (g.sym->type->kind == st::TypeKind::Bool && is_alarm_name(g.sym->name)) {
+      auto h = st::resolve(app, g.sym->name, &err);
+      if (h) alarms->push_back(*h);
+    }
+  return true;
+}
+
+// --watch, else (when a trace is written) the plant's signals and the alarms.
+bool watch_vars(const po::variables_map& vm, const st::Application& app, const plant::Plant& plant,
+                const std::vector<st::VarHandle>& alarms, std::vector<st::VarHandle>* watch) {
+  if (vm.count("watch")) return resolve_named(vm, "watch", app, watch);
+  if (!vm.count("vcd") && !vm.count("csv")) return true;
+  std::string err;
+  for (const auto& s : plant.signals()) {
+    auto h = st::resolve(app, s.name, &err);  // the program's name for the signal, if any
+    if (!h) h = st::resolve(app, s.address, &err);
+    if (h) {
+      h->path = s.name;
+      watch->push_back(*h);
+    }
+  }
+  for (const auto& a : alarms) watch->push_back(a);
+  return true;
+}
+
+// --vcd and --csv, opened. False after printing why.
+bool open_traces(const po::variables_map& vm, const std::vector<st::VarHandle>& watch, const plant::Plant& plant,
+                 std::vector<std::unique_ptr<report::TraceWriter>>* writers) {
+  std::string err;
+  if (vm.count("vcd")) {
+    const std::string origin = plant.origin();
+    auto w = report::open_vcd(vm["vcd"].as<std::string>(), watch, &err,
+                              fmt::format("plcfi sim on plant {}{}", plant.name(), origin.empty() ? "" : ": " + origin));
+    if (!w) {
+      std::cerr << "plcfi sim: --vcd: " << err << "\n";
+      return false;
+    }
+    writers->push_back(std::move(w));
+  }
+  if (vm.count("csv")) {
+    auto w = report::open_csv(vm["csv"].as<std::string>(), watch, &err);
+    if (!w) {
+      std::cerr << "plcfi sim: --csv: " << err << "\n";
+      return false;
+    }
+    writers->push_back(std::move(w));
+  }
+  return true;
+}
+
+std::vector<report::TraceWriter*> raw_writers(const std::vector<std::unique_ptr<report::TraceWriter>>& writers) {
+  std::vector<report::TraceWriter*> raw;
+  for (auto& w : writers) raw.push_back(w.get());
+  return raw;
+}
+
+// The requirements' monitors, checked every scan by a hook on the runtime. False after
+// printing why.
+bool attach_monitors(const st::Application& app, const monitor::RequirementsFile& reqs, rt::Runtime& runtime,
+                     std::unique_ptr<monitor::MonitorSet>* monitors, std::unique_ptr<MonitorHook>* hook) {
+  std::string err;
+  *monitors = monitor::MonitorSet::create(app, reqs, &err);
+  if (!*monitors) {
     std::cerr << "plcfi sim: " << err << "\n";
+    return false;
+  }
+  *hook = std::make_unique<MonitorHook>(monitors->get());
+  runtime.add_hooks(hook->get());
+  return true;
+}
+
+// The scans of a run: the wall time they took, and why the program stopped ("": it did not).
+struct SimRun {
+  double wall = 0;
+  std::string trap_text;
+};
+
+SimRun run_scans(rt::Runtime& runtime, uint64_t scans) {
+  SimRun run;
+  auto t0 = std::chrono::steady_clock::now();
+  for (uint64_t n = 0; n < scans; ++n) {
+    if (runtime.scan() == rt::ScanStatus::Trapped) run.trap_text = runtime.stop_reason();
+  }
+  run.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return run;
+}
+
+bool close_traces(const std::vector<std::unique_ptr<report::TraceWriter>>& writers) {
+  std::string err;
+  for (auto& w : writers)
+    if (!w->close(&err)) {
+      std::cerr << "plcfi sim: " << err << "\n";
+      return false;
+    }
+  return true;
+}
+
+// A plant from a file: the file, its step and its notes.
+void print_plant_file(const plant::Plant& plant, const rt::Schedule& sched) {
+  const std::string origin = plant.origin();
+  if (origin.empty()) return;
+  const int64_t step = plant.step_ns();
+  std::cout << fmt::format("  plant file      {}{}\n", origin,
+                           step > 0 ? fmt::format(", plant step {}", common::format_duration(step)) : "");
+  for (const auto& n : plant.notes()) std::cout << "  note            " << n << "\n";
+  if (step > sched.tick_ns())
+    std::cout << fmt::format("  note            the plant step is coarser than the base tick: the plant's outputs "
+                             "change at most every {} scans\n",
+                             (step + sched.tick_ns() - 1) / sched.tick_ns());
+}
+
+// The run's summary: what ran on which plant, the times, the plant's figures and the alarms.
+void print_sim_summary(const std::string& program, const plant::Plant& plant, uint64_t seed, const rt::Schedule& sched,
+                       const rt::Runtime& runtime, double wall, const AlarmWatch& alarms) {
+  double simulated = static_cast<double>(runtime.now()) * 1e-9;
+  std::cout << fmt::format("plcfi sim: {} on plant {} (seed {}), base tick {} ms\n", program, plant.name(), seed,
+                           static_cast<double>(sched.tick_ns()) / 1e6);
+  print_plant_file(plant, sched);
+  std::cout << fmt::format("  simulated time  {:.3f} s ({} scans)\n", simulated, runtime.scan_count());
+  std::cout << fmt::format("  wall time       {:.3f} s\n", wall);
+  std::cout << fmt::format("  speed           {:.0f}x real time (simulated seconds per wall second)\n", wall > 0 ? simulated / wall : 0.0);
+  std::string stats;
+  for (const auto& [k, v] : plant.stats()) stats += fmt::format("{}{} {}", stats.empty() ? "" : ", ", k, v);
+  std::cout << "  plant           " << stats << "\n";
+  std::cout << "  alarms raised   " << alarms.summary() << "\n";
+}
+
+// The requirements' verdicts, printed: 1 when one was violated, else 0.
+int requirements_status(const po::variables_map& vm, const monitor::MonitorSet& monitors) {
+  int status = 0;
+  auto verdicts = monitors.verdicts();
+  std::cout << "requirements (" << vm["requirements"].as<std::string>() << "):\n" << monitor::format_verdicts(verdicts);
+  for (const auto& v : verdicts)
+    if (v.violated()) status = 1;
+  return status;
+}
+
+}  // namespace
+
+int cmd_sim(const std::vector<std::string>& args) {
+  po::options_description desc("plcfi sim: run a PLC program on a plant model in virtual time");
+  add_sim_options(desc);
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm,
+                  "plcfi sim --program FILE... --plant stamping [--plant-config F] [--seed N] --duration 1h "
+                  "[--vcd F] [--csv F] [--watch PATH,...] [--requirements REQS.yaml] [--lcov F] [--cobertura F]"))
+    return 0;
+  if (!check_coverage_paths(vm, "plcfi sim")) return 2;
+  const std::vector<std::string> files = program_files(vm);
+  if (files.empty()) {
+    std::cerr << "plcfi sim: no program files (--program FILE...)\n";
     return 2;
   }
+  Requirements req;
+  if (!load_requirements_of(vm, &req)) return 2;
+  auto b = compile_program(vm, files, req.late);
+  if (!b) return 2;
+  const st::Application& app = *b->app;
+  int64_t duration = 0;
+  rt::Schedule sched;
+  if (!sim_timing(vm, app, &duration, &sched)) return 2;
+  auto backend = open_sim(vm, app);
+  if (!backend) return 2;
   rt::Runtime runtime(app, sched, backend.get());
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi sim"))) return 2;
   runtime.machine().set_native(native.get());
   runtime.machine().set_count_hits(coverage_export_wanted(vm));
 
-  // Alarm variables.
-  std::vector<st::VarHandle> alarms;
-  if (vm.count("alarms")) {
-    for (const auto& p : split_list(vm["alarms"].as<std::vector<std::string>>())) {
-      auto h = st::resolve(app, p, &err);
-      if (!h) {
-        std::cerr << "plcfi sim: --alarms: " << err << "\n";
-        return 2;
-      }
-      alarms.push_back(*h);
-    }
-  } else {
-    for (const auto& g : app.globals)
-      if (g.sym->type->kind == st::TypeKind::Bool && is_alarm_name(g.sym->name)) {
-        auto h = st::resolve(app, g.sym->name, &err);
-        if (h) alarms.push_back(*h);
-      }
-  }
+  // The scan hooks, in this order every scan: alarms, traces, requirements.
+  std::vector<st::VarHandle> alarms, watch;
+  if (!alarm_vars(vm, app, &alarms)) return 2;
   AlarmWatch alarm_watch(alarms);
   runtime.add_hooks(&alarm_watch);
-
-  // Traces.
-  std::vector<st::VarHandle> watch;
-  if (vm.count("watch")) {
-    for (const auto& p : split_list(vm["watch"].as<std::vector<std::string>>())) {
-      auto h = st::resolve(app, p, &err);
-      if (!h) {
-        std::cerr << "plcfi sim: --watch: " << err << "\n";
-        return 2;
-      }
-      watch.push_back(*h);
-    }
-  } else if (vm.count("vcd") || vm.count("csv")) {
-    for (const auto& s : backend->plant().signals()) {
-      auto h = st::resolve(app, s.name, &err);  // the program's name for the signal, if any
-      if (!h) h = st::resolve(app, s.address, &err);
-      if (h) {
-        h->path = s.name;
-        watch.push_back(*h);
-      }
-    }
-    for (const auto& a : alarms) watch.push_back(a);
-  }
   std::vector<std::unique_ptr<report::TraceWriter>> writers;
-  if (vm.count("vcd")) {
-    const std::string origin = backend->plant().origin();
-    auto w = report::open_vcd(vm["vcd"].as<std::string>(), watch, &err,
-                              fmt::format("plcfi sim on plant {}{}", backend->plant().name(), origin.empty() ? "" : ": " + origin));
-    if (!w) {
-      std::cerr << "plcfi sim: --vcd: " << err << "\n";
-      return 2;
-    }
-    writers.push_back(std::move(w));
-  }
-  if (vm.count("csv")) {
-    auto w = report::open_csv(vm["csv"].as<std::string>(), watch, &err);
-    if (!w) {
-      std::cerr << "plcfi sim: --csv: " << err << "\n";
-      return 2;
-    }
-    writers.push_back(std::move(w));
-  }
-  std::vector<report::TraceWriter*> raw;
-  for (auto& w : writers) raw.push_back(w.get());
-  TraceHook trace(raw);
-  if (!raw.empty()) runtime.add_hooks(&trace);
-
+  if (!watch_vars(vm, app, backend->plant(), alarms, &watch) || !open_traces(vm, watch, backend->plant(), &writers)) return 2;
+  TraceHook trace(raw_writers(writers));
+  if (!writers.empty()) runtime.add_hooks(&trace);
   std::unique_ptr<monitor::MonitorSet> monitors;
   std::unique_ptr<MonitorHook> monitor_hook;
-  if (!late.empty()) {
-    monitors = monitor::MonitorSet::create(app, reqs, &err);
-    if (!monitors) {
-      std::cerr << "plcfi sim: " << err << "\n";
-      return 2;
-    }
-    monitor_hook = std::make_unique<MonitorHook>(monitors.get());
-    runtime.add_hooks(monitor_hook.get());
-  }
+  if (!req.late.empty() && !attach_monitors(app, req.reqs, runtime, &monitors, &monitor_hook)) return 2;
 
-  uint64_t seed = vm["seed"].as<Count>().value;
+  const uint64_t seed = vm["seed"].as<Count>().value;
   runtime.cold_restart(seed);
-  uint64_t scans = static_cast<uint64_t>(duration / sched.tick_ns());
-  auto t0 = std::chrono::steady_clock::now();
-  std::string trap_text;
-  for (uint64_t n = 0; n < scans; ++n) {
-    if (runtime.scan() == rt::ScanStatus::Trapped) trap_text = runtime.stop_reason();
-  }
-  double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  for (auto& w : writers)
-    if (!w->close(&err)) {
-      std::cerr << "plcfi sim: " << err << "\n";
-      return 2;
-    }
-  double simulated = static_cast<double>(runtime.now()) * 1e-9;
-  std::cout << fmt::format("plcfi sim: {} on plant {} (seed {}), base tick {} ms\n", files.back(), backend->plant().name(), seed,
-                           static_cast<double>(sched.tick_ns()) / 1e6);
-  if (const std::string origin = backend->plant().origin(); !origin.empty()) {
-    const int64_t step = backend->plant().step_ns();
-    std::cout << fmt::format("  plant file      {}{}\n", origin,
-                             step > 0 ? fmt::format(", plant step {}", common::format_duration(step)) : "");
-    for (const auto& n : backend->plant().notes()) std::cout << "  note            " << n << "\n";
-    if (step > sched.tick_ns())
-      std::cout << fmt::format("  note            the plant step is coarser than the base tick: the plant's outputs "
-                               "change at most every {} scans\n",
-                               (step + sched.tick_ns() - 1) / sched.tick_ns());
-  }
-  std::cout << fmt::format("  simulated time  {:.3f} s ({} scans)\n", simulated, runtime.scan_count());
-  std::cout << fmt::format("  wall time       {:.3f} s\n", wall);
-  std::cout << fmt::format("  speed           {:.0f}x real time (simulated seconds per wall second)\n", wall > 0 ? simulated / wall : 0.0);
-  std::string stats;
-  for (const auto& [k, v] : backend->plant().stats()) stats += fmt::format("{}{} {}", stats.empty() ? "" : ", ", k, v);
-  std::cout << "  plant           " << stats << "\n";
-  std::cout << "  alarms raised   " << alarm_watch.summary() << "\n";
-  int status = 0;
-  if (monitors) {
-    auto verdicts = monitors->verdicts();
-    std::cout << "requirements (" << vm["requirements"].as<std::string>() << "):\n" << monitor::format_verdicts(verdicts);
-    for (const auto& v : verdicts)
-      if (v.violated()) status = 1;
-  }
+  const SimRun run = run_scans(runtime, static_cast<uint64_t>(duration / sched.tick_ns()));
+  if (!close_traces(writers)) return 2;
+  print_sim_summary(files.back(), backend->plant(), seed, sched, runtime, run.wall, alarm_watch);
+  const int status = monitors ? requirements_status(vm, *monitors) : 0;
   if (coverage_export_wanted(vm) &&
       !write_coverage_exports(vm, app, runtime.machine().hits(), report::coverage_files(*b), "plcfi_sim", "plcfi sim"))
     return 2;
-  if (!trap_text.empty()) {
-    std::cout << "  program stopped " << trap_text << "\n";
+  if (!run.trap_text.empty()) {
+    std::cout << "  program stopped " << run.trap_text << "\n";
     return 1;
   }
   return status;
