@@ -114,8 +114,10 @@ int cmd_disasm(const std::vector<std::string>& args) {
   return 0;
 }
 
-int cmd_run(const std::vector<std::string>& args) {
-  po::options_description desc("plcfi run: run ST programs in virtual time (the configuration's tasks, or one program)");
+namespace {
+
+// The options of `plcfi run`.
+void add_run_options(po::options_description& desc) {
   desc.add_options()
       ("program", po::value<std::string>(), "program instance or type to run (without a CONFIGURATION)")
       ("cycles", po::value<Count>()->default_value(Count{1}, "1"), "number of base-tick cycles to run")
@@ -132,124 +134,137 @@ int cmd_run(const std::vector<std::string>& args) {
       ("rt-priority", po::value<RtPriority>()->default_value(RtPriority{0}, "0"), "with --realtime: SCHED_FIFO priority (1..99; 0 keeps the normal scheduler)")
       ("cpu", po::value<CpuIndex>()->default_value(CpuIndex{-1}, "-1"), "with --realtime: pin the scan thread to this CPU")
       ("junit", po::value<std::string>(), "with --io or --realtime: JUnit XML with the wake latency, execution time and overruns as properties");
-  po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE] [--realtime [--rt-priority N] [--cpu N]] [--duration T] [--junit F]")) return 0;
-  st::CompileOptions opt;
-  apply_dialect_options(vm, &opt);
-  opt.warnings = false;
-  auto b = load(strings_of(vm, "files"), opt, "run");
-  if (!b || !b->ok()) return 2;
-  const st::Application& app = *b->app;
+}
 
-  rt::Schedule sched;
+// The configuration's tasks, or one program (--program) every --cycle-time. False after
+// printing why.
+bool run_schedule(const po::variables_map& vm, const st::Application& app, rt::Schedule* sched) {
   std::string err;
   bool ok_sched;
   if (app.has_configuration && !vm.count("program")) {
-    ok_sched = sched.from_configuration(app, &err);
+    ok_sched = sched->from_configuration(app, &err);
   } else {
     int64_t cycle = 0;
     if (!rt::parse_duration(vm["cycle-time"].as<std::string>(), &cycle, &err)) {
       std::cerr << "plcfi run: --cycle-time: " << err << "\n";
-      return 2;
+      return false;
     }
-    ok_sched = sched.single_program(app, vm.count("program") ? vm["program"].as<std::string>() : "", cycle, &err);
+    ok_sched = sched->single_program(app, vm.count("program") ? vm["program"].as<std::string>() : "", cycle, &err);
   }
   if (!ok_sched) {
     std::cerr << "plcfi run: " << err << "\n";
-    return 2;
+    return false;
   }
-  std::unique_ptr<st::NativeCode> native;
-  if (vm.count("native") && !(native = load_native(app, "plcfi run"))) return 2;
-  if (vm.count("io") || vm.count("realtime")) {
-    RunIoOptions o;
-    o.native = native.get();
-    // Real I/O is always paced: unpaced scans would hammer the devices (and the plant)
-    // millions of times a second.
-    o.realtime = vm.count("realtime") > 0 || vm.count("io") > 0;
-    o.rt.priority = static_cast<int>(vm["rt-priority"].as<RtPriority>().value);
-    o.rt.cpu = static_cast<int>(vm["cpu"].as<CpuIndex>().value);
-    if (vm.count("junit")) o.junit = vm["junit"].as<std::string>();
-    if (vm.count("duration") && (!rt::parse_duration(vm["duration"].as<std::string>(), &o.duration_ns, &err) || o.duration_ns <= 0)) {
-      std::cerr << "plcfi run: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
-      return 2;
-    }
-    if (!vm["cycles"].defaulted() || !vm.count("duration")) o.cycles = vm["cycles"].as<Count>().value;
-    std::vector<std::string> sets = vm.count("set") ? vm["set"].as<std::vector<std::string>>() : std::vector<std::string>{};
-    std::vector<std::string> prints = vm.count("print") ? vm["print"].as<std::vector<std::string>>() : std::vector<std::string>{};
-    auto setup = [&](st::Machine& mm) {
-      mm.set_budget(vm["budget"].as<Count>().value);
-      for (const auto& sv : sets) {
-        auto eq = sv.find('=');
-        auto h = eq == std::string::npos ? std::nullopt : st::resolve(app, sv.substr(0, eq), &err);
-        if (!h || !st::write_text(mm, *h, sv.substr(eq + 1), &err)) {
-          std::cerr << "plcfi run: --set '" << sv << "': " << (eq == std::string::npos ? "expected PATH=VALUE" : err) << "\n";
-          return false;
-        }
-      }
-      for (const auto& p : prints)
-        if (!st::resolve(app, p, &err)) {
-          std::cerr << "plcfi run: --print: " << err << "\n";
-          return false;
-        }
-      return true;
-    };
-    auto report = [&](st::Machine& mm, int) {
-      for (const auto& p : prints) {
-        auto h = st::resolve(app, p, &err);
-        std::cout << h->path << " = " << st::format(mm, *h) << "\n";
-      }
-    };
-    return run_with_io(app, sched, vm.count("io") ? vm["io"].as<std::string>() : "", o, setup, report);
+  return true;
+}
+
+// The options of a paced run (--io, --realtime). False after printing why.
+bool paced_options(const po::variables_map& vm, const st::NativeCode* native, RunIoOptions* o) {
+  o->native = native;
+  // Real I/O is always paced: unpaced scans would hammer the devices (and the plant)
+  // millions of times a second.
+  o->realtime = vm.count("realtime") > 0 || vm.count("io") > 0;
+  o->rt.priority = static_cast<int>(vm["rt-priority"].as<RtPriority>().value);
+  o->rt.cpu = static_cast<int>(vm["cpu"].as<CpuIndex>().value);
+  if (vm.count("junit")) o->junit = vm["junit"].as<std::string>();
+  std::string err;
+  if (vm.count("duration") && (!rt::parse_duration(vm["duration"].as<std::string>(), &o->duration_ns, &err) || o->duration_ns <= 0)) {
+    std::cerr << "plcfi run: --duration: " << (err.empty() ? "must be positive" : err) << "\n";
+    return false;
   }
-  st::Machine m(app);
-  m.set_budget(vm["budget"].as<Count>().value);
-  m.set_native(native.get());
-  int status = 0;
-  std::string trap_text;
-  // The start: FB_init of every instance (CODESYS); --set values then override.
-  if (!m.cold_restart()) {
-    trap_text = st::describe_trap(app, m.trap()) + " (in FB_init at the start)";
-    status = 1;
-  }
-  if (vm.count("set")) {
-    for (const auto& s : vm["set"].as<std::vector<std::string>>()) {
-      auto eq = s.find('=');
-      if (eq == std::string::npos) {
-        std::cerr << "plcfi run: --set '" << s << "': expected PATH=VALUE\n";
-        return 2;
-      }
-      auto h = st::resolve(app, s.substr(0, eq), &err);
-      if (!h || !st::write_text(m, *h, s.substr(eq + 1), &err)) {
-        std::cerr << "plcfi run: --set: " << err << "\n";
-        return 2;
+  if (!vm["cycles"].defaulted() || !vm.count("duration")) o->cycles = vm["cycles"].as<Count>().value;
+  return true;
+}
+
+// --io or --realtime: the program paced in real time, on real I/O or none; --set applied
+// after the cold restart, --print at the end.
+int run_paced(const po::variables_map& vm, const st::Application& app, const rt::Schedule& sched, const st::NativeCode* native) {
+  RunIoOptions o;
+  if (!paced_options(vm, native, &o)) return 2;
+  std::vector<std::string> sets = strings_of(vm, "set");
+  std::vector<std::string> prints = strings_of(vm, "print");
+  std::string err;
+  auto setup = [&](st::Machine& mm) {
+    mm.set_budget(vm["budget"].as<Count>().value);
+    for (const auto& sv : sets) {
+      auto eq = sv.find('=');
+      auto h = eq == std::string::npos ? std::nullopt : st::resolve(app, sv.substr(0, eq), &err);
+      if (!h || !st::write_text(mm, *h, sv.substr(eq + 1), &err)) {
+        std::cerr << "plcfi run: --set '" << sv << "': " << (eq == std::string::npos ? "expected PATH=VALUE" : err) << "\n";
+        return false;
       }
     }
-  }
-  std::vector<st::VarHandle> prints;
-  if (vm.count("print")) {
-    for (const auto& p : vm["print"].as<std::vector<std::string>>()) {
-      auto h = st::resolve(app, p, &err);
-      if (!h) {
+    for (const auto& p : prints)
+      if (!st::resolve(app, p, &err)) {
         std::cerr << "plcfi run: --print: " << err << "\n";
-        return 2;
+        return false;
       }
-      prints.push_back(*h);
+    return true;
+  };
+  auto report = [&](st::Machine& mm, int) {
+    for (const auto& p : prints) {
+      auto h = st::resolve(app, p, &err);
+      std::cout << h->path << " = " << st::format(mm, *h) << "\n";
+    }
+  };
+  return run_with_io(app, sched, vm.count("io") ? vm["io"].as<std::string>() : "", o, setup, report);
+}
+
+// --set PATH=VALUE, written before the first cycle. False after printing why.
+bool apply_sets(const po::variables_map& vm, const st::Application& app, st::Machine& m) {
+  std::string err;
+  for (const auto& s : strings_of(vm, "set")) {
+    auto eq = s.find('=');
+    if (eq == std::string::npos) {
+      std::cerr << "plcfi run: --set '" << s << "': expected PATH=VALUE\n";
+      return false;
+    }
+    auto h = st::resolve(app, s.substr(0, eq), &err);
+    if (!h || !st::write_text(m, *h, s.substr(eq + 1), &err)) {
+      std::cerr << "plcfi run: --set: " << err << "\n";
+      return false;
     }
   }
-  uint64_t cycles = vm["cycles"].as<Count>().value;
+  return true;
+}
+
+// --print: the variables printed at the end. False after printing why.
+bool resolve_prints(const po::variables_map& vm, const st::Application& app, std::vector<st::VarHandle>* prints) {
+  std::string err;
+  for (const auto& p : strings_of(vm, "print")) {
+    auto h = st::resolve(app, p, &err);
+    if (!h) {
+      std::cerr << "plcfi run: --print: " << err << "\n";
+      return false;
+    }
+    prints->push_back(*h);
+  }
+  return true;
+}
+
+// Up to `cycles` base ticks in virtual time, until a trap (*status 1, *trap_text why); what
+// the program logs goes to stderr as it happens. Returns the cycles completed.
+uint64_t run_cycles(const st::Application& app, const rt::Schedule& sched, st::Machine& m, uint64_t cycles, int* status,
+                    std::string* trap_text) {
   uint64_t done = 0;
-  for (uint64_t n = 0; n < cycles && status == 0; ++n) {
+  for (uint64_t n = 0; n < cycles && *status == 0; ++n) {
     m.set_now(static_cast<int64_t>(n) * sched.tick_ns());
     m.clear_taken();
-    if (!sched.run_due(app, m, n, &trap_text)) status = 1;
+    if (!sched.run_due(app, m, n, trap_text)) *status = 1;
     // What the program logged (ADSLOGSTR, ...), as it happened, beside the trap messages.
     for (const auto& entry : m.log()) std::cerr << "[" << entry.level << "] " << entry.text << "\n";
     m.log().clear();
     m.merge_coverage();
-    if (status == 0) ++done;
+    if (*status == 0) ++done;
   }
-  if (!trap_text.empty()) std::cerr << trap_text << "\n";
+  return done;
+}
+
+// The --print variables at the end: as text, or (--json) one JSON line with the run's
+// figures.
+void print_values(const po::variables_map& vm, const st::Machine& m, const std::vector<st::VarHandle>& prints, uint64_t done,
+                  const rt::Schedule& sched, const std::string& trap_text) {
   if (vm.count("json")) {
     Json j;
     j["cycles"] = done;
@@ -262,8 +277,49 @@ int cmd_run(const std::vector<std::string>& args) {
   } else {
     for (const auto& h : prints) std::cout << h.path << " = " << st::format(m, h) << "\n";
   }
+}
+
+// The program in virtual time, unpaced: --cycles base ticks from a cold restart and --set.
+int run_virtual(const po::variables_map& vm, const st::Application& app, const rt::Schedule& sched,
+                const st::NativeCode* native) {
+  st::Machine m(app);
+  m.set_budget(vm["budget"].as<Count>().value);
+  m.set_native(native);
+  int status = 0;
+  std::string trap_text;
+  // The start: FB_init of every instance (CODESYS); --set values then override.
+  if (!m.cold_restart()) {
+    trap_text = st::describe_trap(app, m.trap()) + " (in FB_init at the start)";
+    status = 1;
+  }
+  std::vector<st::VarHandle> prints;
+  if (!apply_sets(vm, app, m) || !resolve_prints(vm, app, &prints)) return 2;
+  const uint64_t done = run_cycles(app, sched, m, vm["cycles"].as<Count>().value, &status, &trap_text);
+  if (!trap_text.empty()) std::cerr << trap_text << "\n";
+  print_values(vm, m, prints, done, sched, trap_text);
   if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
   return status;
+}
+
+}  // namespace
+
+int cmd_run(const std::vector<std::string>& args) {
+  po::options_description desc("plcfi run: run ST programs in virtual time (the configuration's tasks, or one program)");
+  add_run_options(desc);
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm, "plcfi run FILES... [--program NAME] [--cycles N] [--cycle-time 10ms] [--set PATH=VALUE]... [--print PATH]... [--json] [--io FILE] [--realtime [--rt-priority N] [--cpu N]] [--duration T] [--junit F]")) return 0;
+  st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
+  opt.warnings = false;
+  auto b = load(strings_of(vm, "files"), opt, "run");
+  if (!b || !b->ok()) return 2;
+  const st::Application& app = *b->app;
+  rt::Schedule sched;
+  if (!run_schedule(vm, app, &sched)) return 2;
+  std::unique_ptr<st::NativeCode> native;
+  if (vm.count("native") && !(native = load_native(app, "plcfi run"))) return 2;
+  if (vm.count("io") || vm.count("realtime")) return run_paced(vm, app, sched, native.get());
+  return run_virtual(vm, app, sched, native.get());
 }
 
 namespace {
