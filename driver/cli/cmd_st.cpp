@@ -445,17 +445,11 @@ int run_tcunit_suites(const st::Build& b, const st::CompileOptions& opt, const p
   return 0;
 }
 
-// `plcfi test --until EXPR`: the program scans until EXPR holds; then FB_ASSERT's log is
-// reported, one group per unit under test. EXPR is compiled as a PROGRAM linked onto the
-// program, so it reaches every instance by path.
-int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileOptions& opt, int64_t timeout_ns,
-                   const TestSelection& sel) {
-  const std::string expr = vm["until"].as<std::string>();
-  if (!b.tests.empty()) {
-    std::cerr << "plcfi test: --until scans the program until a condition holds; it takes no test files "
-                 "(TEST ... END_TEST): run them without --until\n";
-    return 2;
-  }
+// The --until condition EXPR compiled as a PROGRAM linked onto the program, so it reaches
+// every instance by path; its instance, with its output `reached` in *reached. Null after
+// printing why.
+const st::ProgramInstance* link_until(st::Build& b, const std::string& expr, const st::CompileOptions& opt,
+                                      const st::Symbol** reached) {
   const std::string head = "PROGRAM _PLCFI_UNTIL\nVAR_OUTPUT reached : BOOL; END_VAR\nreached := ";
   st::LineOrigin origin;
   origin.path = "--until";
@@ -469,7 +463,7 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
   if (!st::link_generated(b, {src}, strict)) {
     std::cerr << b.diags.render_all();
     std::cerr << "plcfi test: --until '" << expr << "' is not a BOOL expression over the program's variables\n";
-    return 2;
+    return nullptr;
   }
   // One expression: text that closes the assignment and goes on (`X; END_PROGRAM ...`)
   // would compile as statements or POUs of its own.
@@ -477,33 +471,65 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
   if (cond.pous.size() != 1 || cond.pous[0]->body.size() != 1 || !cond.types.empty() || !cond.globals.empty() ||
       !cond.configs.empty()) {
     std::cerr << "plcfi test: --until '" << expr << "' is not one expression: give a single BOOL condition\n";
-    return 2;
+    return nullptr;
   }
-  const st::Application& app = *b.app;
   const st::ProgramInstance* until = nullptr;
-  for (const auto& o : app.observers)
+  for (const auto& o : b.app->observers)
     if (st::iequals(o.name, "_PLCFI_UNTIL")) until = &o;
-  const st::Symbol* reached = until ? until->pou->find_var("reached") : nullptr;
-  if (!reached) {
+  *reached = until ? until->pou->find_var("reached") : nullptr;
+  if (!*reached) {
     std::cerr << "plcfi test: --until: the condition's program is missing\n";
+    return nullptr;
+  }
+  return until;
+}
+
+// --until --list: the FB_ASSERT units, as FB_init names them; their states show only as
+// the program runs.
+int list_fb_assert_units(const st::Application& app, const TestSelection& sel) {
+  st::Machine m(app);
+  std::string trap;
+  const std::vector<std::string> units = testing::fb_assert_units(app, m, &trap);
+  if (!trap.empty()) {
+    std::cerr << trap << "\n";
+    return 1;
+  }
+  size_t listed = 0;
+  for (const auto& u : units)
+    if (sel.filter.names_suite(u)) {
+      std::cout << u << "\n";
+      ++listed;
+    }
+  return listed == 0 && !sel.filter.empty() ? no_test_selected() : 0;
+}
+
+// The FB_ASSERT line: the assertions evaluated and failed, the failures logged, and how the
+// run ended.
+void print_fb_assert_line(const testing::UntilReport& rep, const testing::Totals& logged, int64_t timeout_ns) {
+  const std::string ending = rep.reached ? fmt::format("--until held after {} of virtual time ({} cycles)",
+                                                         common::format_duration(rep.virtual_ns), rep.cycles)
+                             : rep.program_trap.empty()
+                                 ? fmt::format("--until did not hold within the time-out ({}, {} cycles)",
+                                               common::format_duration(timeout_ns), rep.cycles)
+                                 : fmt::format("a runtime error ended the run after {} cycles", rep.cycles);
+  std::cout << fmt::format("FB_ASSERT: {} assertions evaluated, {} failed, {} failures logged; {}\n", rep.checks,
+                           rep.failures, logged.failed, ending);
+}
+
+// `plcfi test --until EXPR`: the program scans until EXPR holds; then FB_ASSERT's log is
+// reported, one group per unit under test.
+int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileOptions& opt, int64_t timeout_ns,
+                   const TestSelection& sel) {
+  if (!b.tests.empty()) {
+    std::cerr << "plcfi test: --until scans the program until a condition holds; it takes no test files "
+                 "(TEST ... END_TEST): run them without --until\n";
     return 2;
   }
-  if (sel.list) {  // the units, as FB_init names them; their states show only as the program runs
-    st::Machine m(app);
-    std::string trap;
-    const std::vector<std::string> units = testing::fb_assert_units(app, m, &trap);
-    if (!trap.empty()) {
-      std::cerr << trap << "\n";
-      return 1;
-    }
-    size_t listed = 0;
-    for (const auto& u : units)
-      if (sel.filter.names_suite(u)) {
-        std::cout << u << "\n";
-        ++listed;
-      }
-    return listed == 0 && !sel.filter.empty() ? no_test_selected() : 0;
-  }
+  const st::Symbol* reached = nullptr;
+  const st::ProgramInstance* until = link_until(b, vm["until"].as<std::string>(), opt, &reached);
+  if (!until) return 2;
+  const st::Application& app = *b.app;
+  if (sel.list) return list_fb_assert_units(app, sel);
   rt::Schedule sched;
   if (!tcunit_schedule(app, vm, &sched, "--until scans the program's tasks")) return 2;
   st::Machine m(app);
@@ -522,14 +548,7 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
   report::print_tests(std::cout, suites);
   const testing::Totals logged = testing::totals(suites);
   if (rep.overflow) std::cout << "  (the log holds 500 entries: later ones were not kept)\n";
-  const std::string ending = rep.reached ? fmt::format("--until held after {} of virtual time ({} cycles)",
-                                                         common::format_duration(rep.virtual_ns), rep.cycles)
-                             : rep.program_trap.empty()
-                                 ? fmt::format("--until did not hold within the time-out ({}, {} cycles)",
-                                               common::format_duration(timeout_ns), rep.cycles)
-                                 : fmt::format("a runtime error ended the run after {} cycles", rep.cycles);
-  std::cout << fmt::format("FB_ASSERT: {} assertions evaluated, {} failed, {} failures logged; {}\n", rep.checks,
-                           rep.failures, logged.failed, ending);
+  print_fb_assert_line(rep, logged, timeout_ns);
   if (vm.count("coverage")) std::cout << st::coverage_report(app, m.covered());
   // Every evaluation counts, also a failure logged once for several cycles of one state;
   // a state that outlasted --test-timeout fails too.
@@ -540,12 +559,8 @@ int run_until_mode(st::Build& b, const po::variables_map& vm, const st::CompileO
   return rep.failures > 0 || logged.failed > 0 || !rep.reached ? 1 : 0;
 }
 
-}  // namespace
-
-int cmd_test(const std::vector<std::string>& args) {
-  po::options_description desc(
-      "plcfi test: run ST unit tests: test files (sources and test files in any order) and TcUnit suites "
-      "(function blocks that EXTEND FB_TestSuite, run by TcUnit.RUN())");
+// The options of `plcfi test`.
+void add_test_options(po::options_description& desc) {
   desc.add_options()
       ("junit", po::value<std::string>(), "write JUnit XML to this file")
       ("coverage", "print branch coverage of the sources")
@@ -562,42 +577,83 @@ int cmd_test(const std::vector<std::string>& args) {
       ("test-timeout", po::value<std::string>(), "a time-out per test beside --timeout: a TcUnit test not finished that long after its start fails (the others go on); a test file's test that advanced the clock further fails; an FB_ASSERT unit staying longer in one state fails there")
       ("until", po::value<std::string>(), "scan the program until this ST condition holds (e.g. 'PRG_TEST.fbTest.bDone'), then report FB_ASSERT's failed assertions");
   add_coverage_export_options(desc);
-  po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--filter GLOB] [--list] [--junit FILE] [--coverage] [--lcov FILE] [--cobertura FILE] [--timeout 10s] [--test-timeout D] [--until EXPR] [--xunit FILE]")) return 0;
-  if (!check_coverage_paths(vm, "plcfi test")) return 2;
-  int64_t timeout_ns = 0;
+}
+
+// --timeout, which must be positive. False after printing why.
+bool timeout_option(const po::variables_map& vm, int64_t* timeout_ns) {
   std::string err;
-  if (!rt::parse_duration(vm["timeout"].as<std::string>(), &timeout_ns, &err) || timeout_ns <= 0) {
+  if (!rt::parse_duration(vm["timeout"].as<std::string>(), timeout_ns, &err) || *timeout_ns <= 0) {
     std::cerr << "plcfi test: --timeout: " << (err.empty() ? "must be positive" : err) << "\n";
-    return 2;
+    return false;
   }
+  return true;
+}
+
+// The compile options of tests: the dialect, TcUnit's parameters, the test built-ins.
+// False after printing why.
+bool test_compile_options(const po::variables_map& vm, st::CompileOptions* opt) {
+  apply_dialect_options(vm, opt);
+  if (!tcunit_params(vm, &opt->tcunit_params)) return false;
+  opt->test_mode = true;
+  opt->warnings = false;
+  return true;
+}
+
+// Test files or TcUnit suites among the inputs; false after saying there are none (and
+// pointing FB_ASSERT tests to --until).
+bool has_tests(const st::Build& b, bool tcunit) {
+  if (!b.tests.empty() || tcunit) return true;
+  std::cerr << "plcfi test: no tests among the inputs: neither a test file (it starts with TEST, SETUP or TEARDOWN) "
+               "nor a TcUnit suite instance (of a function block that EXTENDS FB_TestSuite)"
+            << (testing::has_fb_assert(*b.app) ? "; tests with FB_ASSERT run with --until EXPR (e.g. the test FB's bDone)" : "")
+            << "\n";
+  return false;
+}
+
+// --list: what would run, without running it.
+int list_tests(const st::Build& b, const TestSelection& sel) {
+  std::vector<std::string> names = testing::list_test_files(*b.app, sel.filter);
+  for (auto& n : testing::list_tcunit(b, sel.filter)) names.push_back(std::move(n));
+  for (const auto& n : names) std::cout << n << "\n";
+  if (names.empty() && !sel.filter.empty()) return no_test_selected();
+  return 0;
+}
+
+// The test files' tests, run and printed.
+std::vector<testing::TestSuite> run_test_files(const po::variables_map& vm, const st::Application& app, st::Machine& m,
+                                               const TestSelection& sel) {
+  testing::TestRunOptions ro;
+  ro.budget = vm["budget"].as<Count>().value;
+  ro.filter = &sel.filter;
+  ro.test_timeout_ns = sel.test_timeout_ns;
+  std::vector<testing::TestSuite> suites = testing::test_file_suites(testing::run_tests(app, m, ro));
+  report::print_tests(std::cout, suites);
+  return suites;
+}
+
+}  // namespace
+
+int cmd_test(const std::vector<std::string>& args) {
+  po::options_description desc(
+      "plcfi test: run ST unit tests: test files (sources and test files in any order) and TcUnit suites "
+      "(function blocks that EXTEND FB_TestSuite, run by TcUnit.RUN())");
+  add_test_options(desc);
+  po::variables_map vm;
+  if (!parse_args(args, desc, vm, "plcfi test SOURCES... TESTS... [--filter GLOB] [--list] [--junit FILE] [--coverage] [--lcov FILE] [--cobertura FILE] [--timeout 10s] [--test-timeout D] [--until EXPR] [--xunit FILE]")) return 0;
+  int64_t timeout_ns = 0;
   TestSelection sel;
-  if (!test_selection(vm, &sel)) return 2;
   st::CompileOptions opt;
-  apply_dialect_options(vm, &opt);
-  if (!tcunit_params(vm, &opt.tcunit_params)) return 2;
-  opt.test_mode = true;
-  opt.warnings = false;
+  if (!check_coverage_paths(vm, "plcfi test") || !timeout_option(vm, &timeout_ns) || !test_selection(vm, &sel) ||
+      !test_compile_options(vm, &opt))
+    return 2;
   auto b = load(strings_of(vm, "files"), opt, "test");
   if (!b || !b->ok()) return 2;
   if (vm.count("until")) return run_until_mode(*b, vm, opt, timeout_ns, sel);
   const st::Application& app = *b->app;
   const bool tcunit = testing::has_tcunit_suites(app);
-  if (b->tests.empty() && !tcunit) {
-    std::cerr << "plcfi test: no tests among the inputs: neither a test file (it starts with TEST, SETUP or TEARDOWN) "
-                 "nor a TcUnit suite instance (of a function block that EXTENDS FB_TestSuite)"
-              << (testing::has_fb_assert(app) ? "; tests with FB_ASSERT run with --until EXPR (e.g. the test FB's bDone)" : "")
-              << "\n";
-    return 2;
-  }
-  if (sel.list) {  // what would run, without running it
-    std::vector<std::string> names = testing::list_test_files(app, sel.filter);
-    for (auto& n : testing::list_tcunit(*b, sel.filter)) names.push_back(std::move(n));
-    for (const auto& n : names) std::cout << n << "\n";
-    if (names.empty() && !sel.filter.empty()) return no_test_selected();
-    return 0;
-  }
+  if (!has_tests(*b, tcunit)) return 2;
+  if (sel.list) return list_tests(*b, sel);
   rt::Schedule sched;
   if (tcunit && !tcunit_schedule(app, vm, &sched, "TcUnit suites run in the scan of the program that calls TcUnit.RUN()")) return 2;
   st::Machine m(app);
@@ -606,14 +662,7 @@ int cmd_test(const std::vector<std::string>& args) {
   m.set_native(native.get());
   m.set_count_hits(coverage_export_wanted(vm));
   std::vector<testing::TestSuite> suites;
-  if (!b->tests.empty()) {
-    testing::TestRunOptions ro;
-    ro.budget = vm["budget"].as<Count>().value;
-    ro.filter = &sel.filter;
-    ro.test_timeout_ns = sel.test_timeout_ns;
-    suites = testing::test_file_suites(testing::run_tests(app, m, ro));
-    report::print_tests(std::cout, suites);
-  }
+  if (!b->tests.empty()) suites = run_test_files(vm, app, m, sel);
   bool tcunit_ok = true;
   if (tcunit) {
     if (int status = run_tcunit_suites(*b, opt, vm, sched, m, timeout_ns, sel, &suites, &tcunit_ok); status != 0)
