@@ -22,9 +22,8 @@
 #include "options.hpp"
 #include "coverage_opts.hpp"
 #include "json.hpp"
-#include "html_campaign.hpp"
-#include "report/junit.hpp"
-#include "report/puml.hpp"
+#include "report/campaign.hpp"
+#include "report/campaign_html.hpp"
 
 #include "io/bench/bench_io.hpp"
 #include <sstream>
@@ -38,48 +37,6 @@ namespace {
 using campaign::CampaignBuild;
 using campaign::TestCase;
 
-std::string fault_text(const TestCase& tc) {
-  return fmt::format("{} ({}): {}", tc.target->name, tc.target_ref.text, tc.fault.text);
-}
-
-std::string pad(std::string s, size_t n) {
-  if (s.size() > n) return s.substr(0, n - 1) + "~";
-  s.resize(n, ' ');
-  return s;
-}
-
-report::PumlCase puml_case(const CampaignBuild& cb, const TestCase& tc) {
-  report::PumlCase p;
-  p.id = tc.id;
-  p.title = tc.transition_ref() + ": " + tc.row->failure_mode;
-  p.precondition = tc.precondition;
-  p.start = tc.step->start;
-  p.target = tc.target->name + " (" + tc.target_ref.text + ")";
-  p.fault = tc.fault.text;
-  p.reaction = tc.expected;
-  p.deadline_ns = tc.deadline_ns;
-  p.max_duration_ns = tc.max_duration_ns;
-  p.fault_class = tc.cls->id + (tc.cls->name.empty() ? "" : " " + tc.cls->name);
-  p.restart = cb.spec.restart == campaign::RestartKind::Cold ? "cold" : "warm";
-  p.rpn = tc.rpn;
-  for (const auto& t : tc.step->transitions) {
-    report::PumlTransition x;
-    x.lifeline = t.lifeline;
-    x.to = t.to;
-    std::string up = st::canon(t.to);
-    x.from = up == "TRUE" ? "FALSE" : up == "FALSE" ? "TRUE" : "before";
-    for (const auto& ps : tc.step->pre)
-      if (ps.lifeline == t.lifeline) x.from = ps.value;
-    x.faulted = &t == tc.transition;
-    x.min_ns = t.min_ns;
-    x.max_ns = t.max_ns;
-    const auto* l = cb.spec.tsd.find(t.lifeline);
-    x.tolerance = t.tolerance >= 0 ? t.tolerance : (l ? l->tolerance : 0);
-    p.transitions.push_back(x);
-  }
-  return p;
-}
-
 bool write_diagrams(const CampaignBuild& cb, const std::string& dir, std::string* err) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
@@ -88,7 +45,7 @@ bool write_diagrams(const CampaignBuild& cb, const std::string& dir, std::string
     return false;
   }
   for (const auto& tc : cb.cases) {
-    auto p = puml_case(cb, tc);
+    auto p = report::campaign_puml_case(cb, tc);
     for (const auto& [suffix, text] : {std::pair{"sequence", report::sequence_diagram(p)}, {"timing", report::timing_diagram(p)}}) {
       std::string path = (std::filesystem::path(dir) / fmt::format("{}_{}.puml", tc.id, suffix)).string();
       std::ofstream f(path);
@@ -125,27 +82,7 @@ bool load_and_prepare(const std::string& path, const std::vector<std::string>& p
   return true;
 }
 
-void print_cases(const CampaignBuild& cb) {
-  const auto& c = cb.spec;
-  std::cout << fmt::format("campaign {}: {} test case(s) from {} and {}\n", c.name, cb.cases.size(), c.fmea.path, c.tsd.path);
-  std::cout << fmt::format("  program {}, plant {}, base tick {}, classes {}\n\n", c.programs.back(), c.plant,
-                           campaign::human_duration(cb.schedule.tick_ns()), c.classes.path);
-  std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad("case", 5), pad("RPN", 4), pad("FMEA", 5), pad("class", 6),
-                           pad("transition", 30), pad("fault", 40), "deadline");
-  for (const auto& tc : cb.cases)
-    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad(std::to_string(tc.rpn), 4), pad(tc.explored ? "-" : tc.row->id, 5),
-                             pad(tc.cls->id, 6), pad(tc.transition_ref(), 30), pad(fault_text(tc), 40),
-                             campaign::human_duration(tc.deadline_ns));
-  std::cout << "\n";
-  for (const auto& tc : cb.cases) {
-    std::cout << fmt::format("{}: {}\n", tc.id, tc.row->failure_mode);
-    std::cout << fmt::format("  precondition  {}\n", tc.precondition);
-    std::cout << fmt::format("  start         {}\n", tc.step->start.empty() ? "previous transition (the precondition)" : tc.start);
-    std::cout << fmt::format("  expected      {}\n", tc.expected);
-    for (size_t k = tc.first_req + tc.reqs - tc.forbidden; k < tc.first_req + tc.reqs; ++k)
-      std::cout << fmt::format("  forbidden     {}\n", cb.monitors.requirements[k].text);
-  }
-}
+void print_cases(const CampaignBuild& cb) { std::cout << report::campaign_cases_text(cb); }
 
 // Milliseconds as JSON: an integer when whole (600, not 600.0), else a fraction.
 Json json_ms(int64_t ns) {
@@ -190,10 +127,7 @@ bool print_suggestions(const CampaignBuild& cb, const campaign::CampaignResult& 
     std::cerr << "plcfi campaign: " << path << ": cannot write\n";
     return false;
   }
-  std::cout << fmt::format("\nFMEA suggestions: {} (the failures the FMEA misses, as rows in {})\n", sug.size(), path);
-  for (const auto& x : sug)
-    std::cout << fmt::format("  {} {}: {}; effect seen: {}; detecting alarm: {}\n", pad(x.case_id, 5), x.component,
-                             x.failure_mode, x.effect, x.detection);
+  std::cout << report::fmea_suggestions_text(sug, path);
   return true;
 }
 
@@ -374,7 +308,7 @@ bool read_baseline(const po::variables_map& vm, const campaign::Campaign& c, Cam
 // writable, the diagrams are written. False after printing why.
 bool prepare_outputs(const po::variables_map& vm, const CampaignBuild& cb, const std::string& out) {
   std::string err;
-  if (vm.count("html") && !html_dir_writable(vm["html"].as<std::string>(), &err)) {
+  if (vm.count("html") && !report::html_dir_writable(vm["html"].as<std::string>(), &err)) {
     std::cerr << "plcfi campaign: " << err << "\n";
     return false;
   }
@@ -527,59 +461,10 @@ bool run(const po::variables_map& vm, CampaignBuild& cb, const CampaignArgs& a, 
   return true;
 }
 
-// A case without an execution in the summary table: NOT REACHED or NOT TESTED, and why.
-void print_unrun_row(const TestCase& tc, const char* verdict, const std::string& why) {
-  std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(tc.id, 5), pad("-", 5), pad(verdict, 12), pad("-", 9),
-                           pad(std::to_string(tc.rpn), 4), pad(tc.transition_ref(), 30), why);
-}
-
-// The summary table: the executions by case and path, then the cases that did not run.
-// Returns the number of executions that did not pass.
-size_t print_verdict_table(const CampaignBuild& cb, const campaign::CampaignResult& res) {
-  std::cout << fmt::format("\n{} {} {} {} {} {} {}\n", pad("case", 5), pad("path", 5), pad("verdict", 12), pad("latency", 9),
-                           pad("RPN", 4), pad("transition", 30), "fault / reason");
-  size_t fail = 0;
-  std::vector<campaign::Execution> table = res.executions;  // by case, then path
-  std::stable_sort(table.begin(), table.end(), [](const auto& a, const auto& b) {
-    return std::tie(a.case_index, a.path) < std::tie(b.case_index, b.path);
-  });
-  for (const auto& e : table) {
-    const auto& tc = cb.cases[e.case_index];
-    fail += e.outcome != campaign::Outcome::Pass;
-    std::string lat = e.latency_ns >= 0 ? fmt::format("{:.0f} ms", static_cast<double>(e.latency_ns) * 1e-6) : "-";
-    std::cout << fmt::format("{} {} {} {} {} {} {}\n", pad(e.case_id, 5), pad(std::to_string(e.path), 5),
-                             pad(campaign::outcome_name(e.outcome), 12), pad(lat, 9), pad(std::to_string(tc.rpn), 4),
-                             pad(tc.transition_ref(), 30), fault_text(tc));
-    if (e.outcome != campaign::Outcome::Pass || tc.explored) std::cout << fmt::format("{}{}\n", std::string(38, ' '), e.reason);
-    auto dist = campaign::distinguishing_branches(cb, res.executions, e);
-    if (!dist.empty()) {
-      std::string list;
-      for (const auto& d : dist) list += (list.empty() ? "" : ", ") + d;
-      std::cout << fmt::format("{}path: {}\n", std::string(38, ' '), list);
-    }
-  }
-  for (size_t i : res.not_reached)
-    print_unrun_row(cb.cases[i], "NOT REACHED", "precondition never held: " + cb.cases[i].precondition);
-  for (size_t i : res.pending) print_unrun_row(cb.cases[i], "NOT TESTED", "campaign interrupted before this case");
-  return fail;
-}
-
 // The totals, the run's figures (scans, time, real-time and I/O figures) and where the
 // files are.
 void print_totals(const CampaignBuild& cb, const Finished& f, size_t fail, const std::string& out) {
-  const auto& res = f.res;
-  const auto& p = res.progress;
-  std::cout << fmt::format(
-      "\n{} execution(s) of {} case(s): {} PASS, {} FAIL, {} NOT REACHED\n", res.executions.size(), cb.cases.size(),
-      res.executions.size() - fail, fail, res.not_reached.size());
-  std::cout << fmt::format("{} run(s), {} scans, {:.1f} s on the scan clock in {:.3f} s wall time; ended: {}\n", p.run,
-                           p.scans, static_cast<double>(p.campaign_ns) * 1e-9, res.wall_s, res.end_reason);
-  std::cout << fmt::format("journal {}/results.jsonl, traces and diagrams in {}\n", out, out);
-  if (!res.realtime_text.empty()) {
-    std::istringstream lines(res.realtime_text);
-    for (std::string l; std::getline(lines, l);) std::cout << "  " << l << "\n";
-  }
-  for (const auto& l : f.io_report) std::cout << "  " << l << "\n";
+  std::cout << report::campaign_totals_text(cb, f.res, f.io_report, fail, out);
 }
 
 // Safety evidence, only when the FMEA gives failure rates (else nothing changes): into
@@ -605,78 +490,16 @@ bool write_safety_evidence(const CampaignBuild& cb, const campaign::CampaignResu
 // What changed since the baseline (the folder `old`), printed; returns the regressions.
 size_t print_baseline_changes(const report::SafetyReport& baseline, const report::SafetyReport& now, const std::string& old) {
   size_t regressions = 0;
-  auto changes = report::compare_safety(baseline, now);
-  for (const auto& ch : changes) regressions += ch.regression;
-  if (changes.empty()) {
-    std::cout << fmt::format("no change since {} (baseline)\n", old);
-  } else {
-    std::cout << fmt::format("{} change(s) since {} (baseline), {} regression(s)\n", changes.size(), old, regressions);
-    for (const auto& ch : changes) std::cout << fmt::format("  {} {}\n", ch.regression ? "REGRESSION" : "changed   ", ch.what);
-  }
+  std::cout << report::baseline_changes_text(report::compare_safety(baseline, now), old, &regressions);
   return regressions;
-}
-
-// An execution as a JUnit test case: the verdict, what was tested and the case's facts.
-report::JunitCase junit_execution(const CampaignBuild& cb, const campaign::CampaignResult& res, const campaign::Execution& e,
-                                  const std::string& suite) {
-  const auto& tc = cb.cases[e.case_index];
-  report::JunitCase jc;
-  jc.classname = suite + "." + tc.transition_ref();
-  jc.name = fmt::format("{} path {}: {}", e.case_id, e.path, tc.row->failure_mode);
-  jc.seconds = static_cast<double>(e.end_ns - e.inject_ns) * 1e-9;
-  jc.outcome = e.outcome == campaign::Outcome::Pass ? report::JunitCase::Outcome::Pass : report::JunitCase::Outcome::Fail;
-  if (e.outcome != campaign::Outcome::Pass) jc.message = e.reason;
-  jc.detail = fmt::format("precondition: {}\nfault: {}\nexpected: {}\nresult: {}", tc.precondition, fault_text(tc),
-                          tc.expected, e.reason);
-  std::string dist;
-  for (const auto& d : campaign::distinguishing_branches(cb, res.executions, e)) dist += (dist.empty() ? "" : ", ") + d;
-  jc.properties = {{"rpn", std::to_string(tc.rpn)},
-                   {"fault_class", tc.cls->id},
-                   {"fmea", tc.row->id},
-                   {"path", std::to_string(e.path)},
-                   {"path_branches", dist},
-                   {"fault", fault_text(tc)},
-                   {"latency_ms", e.latency_ns >= 0 ? fmt::format("{:.1f}", static_cast<double>(e.latency_ns) * 1e-6) : ""},
-                   {"vcd", e.vcd}};
-  return jc;
-}
-
-// A case without an execution as a skipped JUnit test case; `message` says why.
-report::JunitCase junit_skipped(const TestCase& tc, const std::string& suite, std::string message) {
-  report::JunitCase jc;
-  jc.classname = suite + "." + tc.transition_ref();
-  jc.name = fmt::format("{}: {}", tc.id, tc.row->failure_mode);
-  jc.outcome = report::JunitCase::Outcome::Skipped;
-  jc.message = std::move(message);
-  return jc;
 }
 
 // --junit: one suite, the executions, then the cases not tested and not reached; the run's
 // figures and the safety evidence as properties. False after printing why.
 bool write_campaign_junit(const std::string& path, const CampaignBuild& cb, const Finished& f,
                           const std::optional<report::SafetyReport>& safety) {
-  const auto& res = f.res;
-  report::JunitSuite suite;
-  suite.name = "campaign." + cb.spec.name;
-  for (const auto& e : res.executions) suite.cases.push_back(junit_execution(cb, res, e, suite.name));
-  suite.properties = res.realtime;
-  suite.properties.emplace_back("plant", cb.spec.plant);
-  for (size_t i = 0; i < f.io_report.size(); ++i) suite.properties.emplace_back(fmt::format("io_{}", i), f.io_report[i]);
-  if (res.interrupted) suite.properties.emplace_back("incomplete", res.end_reason);
-  if (safety)
-    for (auto& prop : report::safety_junit_properties(*safety)) suite.properties.push_back(std::move(prop));
-  for (size_t i : res.pending)
-    suite.cases.push_back(junit_skipped(cb.cases[i], suite.name,
-                                        "not tested: the campaign was interrupted (" + res.end_reason + "); finish it with --resume"));
-  for (size_t i : res.not_reached) {
-    const auto& tc = cb.cases[i];
-    report::JunitCase jc =
-        junit_skipped(tc, suite.name, "NOT REACHED: the precondition never held (coverage gap): " + tc.precondition);
-    jc.properties = {{"rpn", std::to_string(tc.rpn)}, {"fault_class", tc.cls->id}, {"fmea", tc.row->id}};
-    suite.cases.push_back(jc);
-  }
   std::string err;
-  if (!report::write_junit(path, {suite}, &err)) {
+  if (!report::write_junit(path, {report::campaign_junit(cb, f.res, f.io_report, safety)}, &err)) {
     std::cerr << "plcfi campaign: " << err << "\n";
     return false;
   }
@@ -686,7 +509,7 @@ bool write_campaign_junit(const std::string& path, const CampaignBuild& cb, cons
 // --html DIR: the report with the safety evidence. False after printing why.
 bool write_campaign_html(const std::string& dir, const CampaignBuild& cb, const campaign::CampaignResult& res,
                          const std::string& out, bool vcd, const std::optional<report::SafetyReport>& safety) {
-  auto model = html_campaign_model(cb, res, out, vcd);
+  auto model = report::campaign_html_model(cb, res, out, vcd);
   model.safety = safety;
   std::string err;
   if (!report::write_html_report(model, dir, &err)) {
@@ -752,7 +575,8 @@ int cmd_campaign(const std::vector<std::string>& args) {
   if (!run(vm, cb, a, signals, opt, &f)) return 2;
   if (a.live) std::cerr << "\r" << std::string(72, ' ') << "\r";
   if (f.res.resumed) std::cout << fmt::format("  resumed: {} verdict(s) read from {}/results.jsonl\n", f.res.resumed, a.out);
-  const size_t fail = print_verdict_table(cb, f.res);
+  size_t fail = 0;
+  std::cout << report::campaign_verdict_table(cb, f.res, &fail);
   print_totals(cb, f, fail, a.out);
   if (c.explore.enabled && !print_suggestions(cb, f.res, a.out)) return 2;
   std::optional<report::SafetyReport> safety;

@@ -9,7 +9,7 @@
 #include "json.hpp"
 #include "options.hpp"
 #include "monitor/edtl.hpp"
-#include "report/junit.hpp"
+#include "report/edtl.hpp"
 #include "runtime/schedule.hpp"
 
 namespace po = boost::program_options;
@@ -40,28 +40,6 @@ Json verdicts_json(const std::vector<monitor::Verdict>& vs) {
     out.push_back(std::move(r));
   }
   return out;
-}
-
-bool write_verdicts_junit(const std::string& path, const std::string& suite, const std::vector<monitor::Verdict>& vs,
-                          std::string* err) {
-  report::JunitSuite s;
-  s.name = suite;
-  for (const auto& v : vs) {
-    report::JunitCase c;
-    c.classname = suite;
-    c.name = v.id + (v.text.empty() ? "" : ": " + v.text);
-    if (v.violated()) {
-      c.outcome = report::JunitCase::Outcome::Fail;
-      const auto& x = v.violations.front();
-      c.message = fmt::format("violated at state {} (t={:.3f} s): {}", x.state, static_cast<double>(x.time_ns) * 1e-9,
-                              monitor::cause_text(x.cause));
-      c.detail = monitor::format_verdicts({v});
-    }
-    c.properties = {{"triggers", std::to_string(v.triggers)}, {"pending", std::to_string(v.pending)}};
-    if (!v.severity.empty()) c.properties.emplace_back("severity", v.severity);
-    s.cases.push_back(c);
-  }
-  return report::write_junit(path, {s}, err);
 }
 
 int cmd_edtl(const std::vector<std::string>& args) {
@@ -113,7 +91,7 @@ int cmd_edtl(const std::vector<std::string>& args) {
   } else {
     std::cout << fmt::format("{}: {} states\n", files[1], state) << monitor::format_verdicts(verdicts);
   }
-  if (vm.count("junit") && !write_verdicts_junit(vm["junit"].as<std::string>(), files[0], verdicts, &err)) {
+  if (vm.count("junit") && !report::write_junit(vm["junit"].as<std::string>(), {report::edtl_junit(files[0], verdicts)}, &err)) {
     std::cerr << "plcfi edtl check: " << err << "\n";
     return 2;
   }

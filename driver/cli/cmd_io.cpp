@@ -71,28 +71,16 @@ bool end_safely(rt::Runtime& runtime, io::BenchIo* backend, const io::IoConfig& 
 // the devices' figures as properties. False after printing why.
 bool write_run_junit(const std::string& path, const rt::ScanLoop& loop, const io::BenchIo* backend, const io::IoConfig& cfg,
                      int status, int64_t t0) {
-  const std::string& why = loop.end_reason();
-  report::JunitSuite suite;
-  suite.name = "run";
-  report::JunitCase jc;
-  jc.classname = "run";
-  jc.name = backend ? "scan cycle on " + cfg.path : "scan cycle";
-  jc.seconds = static_cast<double>(rt::RealTimePacer::monotonic_ns() - t0) * 1e-9;
-  if (status != 0) {
-    jc.outcome = report::JunitCase::Outcome::Fail;
-    jc.message = why;
-  }
-  jc.properties.emplace_back("scans", std::to_string(loop.scans()));
-  jc.properties.emplace_back("ended", why);
-  if (loop.paced())
-    for (const auto& p : loop.pacer().properties()) suite.properties.push_back(p);
-  if (backend) {
-    int n = 0;
-    for (const auto& line : backend->report()) suite.properties.emplace_back(fmt::format("io_{}", n++), line);
-  }
-  suite.cases.push_back(jc);
+  report::ScanRunFacts run;
+  run.name = backend ? "scan cycle on " + cfg.path : "scan cycle";
+  run.seconds = static_cast<double>(rt::RealTimePacer::monotonic_ns() - t0) * 1e-9;
+  run.failed = status != 0;
+  run.ended = loop.end_reason();
+  run.scans = loop.scans();
+  if (loop.paced()) run.realtime = loop.pacer().properties();
+  if (backend) run.io_report = backend->report();
   std::string err;
-  if (!report::write_junit(path, {suite}, &err)) {
+  if (!report::write_junit(path, {report::scan_run_junit(run)}, &err)) {
     std::cerr << "plcfi run: " << err << "\n";
     return false;
   }

@@ -10,7 +10,7 @@
 #include "campaign/mutate.hpp"
 #include "campaign/parallel.hpp"
 #include "commands.hpp"
-#include "html_campaign.hpp"
+#include "report/campaign_html.hpp"
 #include "report/html.hpp"
 #include "common/json.hpp"
 #include "options.hpp"
@@ -63,7 +63,7 @@ bool mutate_options(const po::variables_map& vm, campaign::MutateOptions* opt, d
 // usage. False after printing why.
 bool make_output_folders(const po::variables_map& vm, campaign::MutateOptions* opt) {
   std::string err;
-  if (vm.count("html") && !html_dir_writable(vm["html"].as<std::string>(), &err)) {
+  if (vm.count("html") && !report::html_dir_writable(vm["html"].as<std::string>(), &err)) {
     std::cerr << "plcfi mutate: " << err << "\n";
     return false;
   }
@@ -141,7 +141,7 @@ report::MutantRow mutant_row(const campaign::Mutant& m, const campaign::MutantRe
 // The HTML page: the campaign's page (header, TSD) without executions, and the mutants.
 report::HtmlReport mutation_page(const campaign::CampaignBuild& cb, const campaign::MutationRun& run,
                                  const campaign::MutateOptions& opt) {
-  report::HtmlReport page = html_campaign_model(cb, campaign::CampaignResult{}, opt.out_dir, false);
+  report::HtmlReport page = report::campaign_html_model(cb, campaign::CampaignResult{}, opt.out_dir, false);
   page.rows.clear();
   page.executions.clear();
   page.waveform_note.clear();

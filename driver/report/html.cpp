@@ -10,6 +10,8 @@
 #include <memory>
 #include <set>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "monitor/trace_reader.hpp"
@@ -764,6 +766,20 @@ bool write_html_report(const HtmlReport& r, const std::string& dir, std::string*
   ok = std::fclose(f) == 0 && ok;
   if (!ok) *err = path + ": write failed";
   return ok;
+}
+
+bool html_dir_writable(const std::string& dir, std::string* err) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    *err = dir + ": cannot create the folder (" + ec.message() + ")";
+    return false;
+  }
+  if (::access(dir.c_str(), W_OK) != 0) {
+    *err = dir + ": the folder is not writable";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace plcfi::report

@@ -132,6 +132,10 @@ std::string html_report(const HtmlReport& r);
 // Writes DIR/index.html (creating DIR). False with "PATH: reason" in *err when it cannot.
 bool write_html_report(const HtmlReport& r, const std::string& dir, std::string* err);
 
+// Creates DIR and checks that a report can be written there (false, "DIR: reason"); run
+// before a long campaign, so that a bad --html folder is refused at once.
+bool html_dir_writable(const std::string& dir, std::string* err);
+
 // One waveform as an SVG element (exposed for tests). Reads exec.vcd; on a read error
 // returns false with the message in *err.
 bool waveform_svg(const HtmlExecution& exec, std::string* svg, std::string* err);

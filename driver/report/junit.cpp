@@ -127,4 +127,23 @@ bool write_junit(const std::string& path, const std::vector<JunitSuite>& suites,
   return write_file_atomically(path, junit_xml(suites), err);
 }
 
+JunitSuite scan_run_junit(const ScanRunFacts& run) {
+  JunitSuite suite;
+  suite.name = "run";
+  JunitCase jc;
+  jc.classname = "run";
+  jc.name = run.name;
+  jc.seconds = run.seconds;
+  if (run.failed) {
+    jc.outcome = JunitCase::Outcome::Fail;
+    jc.message = run.ended;
+  }
+  jc.properties.emplace_back("scans", std::to_string(run.scans));
+  jc.properties.emplace_back("ended", run.ended);
+  suite.properties = run.realtime;
+  for (size_t n = 0; n < run.io_report.size(); ++n) suite.properties.emplace_back("io_" + std::to_string(n), run.io_report[n]);
+  suite.cases.push_back(jc);
+  return suite;
+}
+
 }  // namespace plcfi::report

@@ -1,5 +1,5 @@
 // The HTML report's model from a campaign's build, result and specs.
-#include "html_campaign.hpp"
+#include "report/campaign_html.hpp"
 
 #include "campaign/explore.hpp"
 
@@ -7,11 +7,9 @@
 #include <filesystem>
 #include <tuple>
 
-#include <unistd.h>
-
 #include <fmt/format.h>
 
-namespace plcfi::cli {
+namespace plcfi::report {
 
 namespace {
 
@@ -155,22 +153,8 @@ void add_tsd(const campaign::CampaignBuild& cb, report::HtmlReport* r) {
 
 }  // namespace
 
-bool html_dir_writable(const std::string& dir, std::string* err) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) {
-    *err = dir + ": cannot create the folder (" + ec.message() + ")";
-    return false;
-  }
-  if (::access(dir.c_str(), W_OK) != 0) {
-    *err = dir + ": the folder is not writable";
-    return false;
-  }
-  return true;
-}
-
-report::HtmlReport html_campaign_model(const campaign::CampaignBuild& cb, const campaign::CampaignResult& res,
-                                       const std::string& out_dir, bool vcd) {
+HtmlReport campaign_html_model(const campaign::CampaignBuild& cb, const campaign::CampaignResult& res,
+                               const std::string& out_dir, bool vcd) {
   report::HtmlReport r;
   r.header = header_of(cb, res, out_dir);
   add_rows(cb, res, out_dir, vcd, &r);
@@ -182,4 +166,4 @@ report::HtmlReport html_campaign_model(const campaign::CampaignBuild& cb, const 
   return r;
 }
 
-}  // namespace plcfi::cli
+}  // namespace plcfi::report
