@@ -25,7 +25,7 @@
 #include "report/campaign.hpp"
 #include "report/campaign_html.hpp"
 
-#include "io/bench/bench_io.hpp"
+#include "io/devices/device_io.hpp"
 #include <sstream>
 
 namespace po = boost::program_options;
@@ -379,7 +379,7 @@ struct Finished {
 
 // The devices of the io file, opened for a campaign on real I/O. Null after printing why:
 // no --arm, a bad io file, devices that cannot be opened.
-std::unique_ptr<io::BenchIo> open_bench(const std::string& io_path, bool armed, const CampaignBuild& cb, io::IoConfig* cfg) {
+std::unique_ptr<io::DeviceIo> open_devices(const std::string& io_path, bool armed, const CampaignBuild& cb, io::IoConfig* cfg) {
   if (!armed) {
     std::cerr << "plcfi campaign: refusing to inject faults on real I/O (" << io_path
               << ") without --arm: the campaign forces sensor values and suppresses or changes actuator commands on the "
@@ -391,14 +391,14 @@ std::unique_ptr<io::BenchIo> open_bench(const std::string& io_path, bool armed, 
     std::cerr << err << "\n";
     return nullptr;
   }
-  auto backend = io::BenchIo::open(*cfg, cb.schedule.tick_ns(), &err);
+  auto backend = io::DeviceIo::open(*cfg, cb.schedule.tick_ns(), &err);
   if (!backend) std::cerr << err << "\n";
   return backend;
 }
 
 // The campaign on the bench, in real time: a stop signal or a lost device withdraws the
 // fault and writes the safe state. The devices are closed after it.
-bool run_on_bench(io::BenchIo& bench, const io::IoConfig& cfg, const std::string& io_path, CampaignBuild& cb,
+bool run_on_devices(io::DeviceIo& bench, const io::IoConfig& cfg, const std::string& io_path, CampaignBuild& cb,
                   const rt::RealtimeOptions& rto, std::optional<rt::StopSignals>& signals, campaign::DriverOptions& opt,
                   Finished* f, std::string* err) {
   signals.emplace();
@@ -447,9 +447,9 @@ bool run(const po::variables_map& vm, CampaignBuild& cb, const CampaignArgs& a, 
   bool ran = false;
   if (!io_path.empty()) {
     io::IoConfig cfg;
-    auto bench = open_bench(io_path, vm.count("arm") > 0, cb, &cfg);
+    auto bench = open_devices(io_path, vm.count("arm") > 0, cb, &cfg);
     if (!bench) return false;
-    ran = run_on_bench(*bench, cfg, io_path, cb, rto, signals, opt, f, &err);
+    ran = run_on_devices(*bench, cfg, io_path, cb, rto, signals, opt, f, &err);
   } else {
     ran = run_offline(vm.count("realtime") > 0, cb, a, rto, signals, opt, f, &err);
   }

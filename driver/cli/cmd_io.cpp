@@ -16,7 +16,7 @@
 #include "runtime/runtime.hpp"
 #include "runtime/schedule.hpp"
 
-#include "io/bench/bench_io.hpp"
+#include "io/devices/device_io.hpp"
 #ifdef PLCFI_HAVE_MODBUS
 #include "io/modbus/plant_server.hpp"
 #endif
@@ -34,14 +34,14 @@ namespace {
 // The io file's devices, opened; none without an io file (the pacing alone: latency
 // measurements). False after printing why.
 bool open_run_io(const std::string& io_path, const st::Application& app, const rt::Schedule& sched, io::IoConfig* cfg,
-                 std::unique_ptr<io::BenchIo>* backend) {
+                 std::unique_ptr<io::DeviceIo>* backend) {
   if (io_path.empty()) return true;
   std::string err;
   if (!io::load_io_config(io_path, app, cfg, &err)) {
     std::cerr << err << "\n";
     return false;
   }
-  *backend = io::BenchIo::open(*cfg, sched.tick_ns(), &err);
+  *backend = io::DeviceIo::open(*cfg, sched.tick_ns(), &err);
   if (!*backend) {
     std::cerr << err << "\n";
     return false;
@@ -52,7 +52,7 @@ bool open_run_io(const std::string& io_path, const st::Application& app, const r
 // Every way out: the safe output state reaches the devices before they are closed; then
 // the line that says how the run ended. False (after printing why) when the safe state could
 // not be written.
-bool end_safely(rt::Runtime& runtime, io::BenchIo* backend, const io::IoConfig& cfg, const rt::ScanLoop& loop,
+bool end_safely(rt::Runtime& runtime, io::DeviceIo* backend, const io::IoConfig& cfg, const rt::ScanLoop& loop,
                 const rt::Schedule& sched) {
   const bool safe = runtime.write_safe_outputs();
   const std::string safe_error = safe || !backend ? std::string() : backend->last_error();
@@ -69,7 +69,7 @@ bool end_safely(rt::Runtime& runtime, io::BenchIo* backend, const io::IoConfig& 
 
 // --junit: the scan cycle as one test case (failed when the run did), the real-time and
 // the devices' figures as properties. False after printing why.
-bool write_run_junit(const std::string& path, const rt::ScanLoop& loop, const io::BenchIo* backend, const io::IoConfig& cfg,
+bool write_run_junit(const std::string& path, const rt::ScanLoop& loop, const io::DeviceIo* backend, const io::IoConfig& cfg,
                      int status, int64_t t0) {
   report::ScanRunFacts run;
   run.name = backend ? "scan cycle on " + cfg.path : "scan cycle";
@@ -92,7 +92,7 @@ bool write_run_junit(const std::string& path, const rt::ScanLoop& loop, const io
 int run_with_io(const st::Application& app, const rt::Schedule& sched, const std::string& io_path, const RunIoOptions& o,
                 const std::function<bool(st::Machine&)>& setup, const std::function<void(st::Machine&, int)>& report) {
   io::IoConfig cfg;
-  std::unique_ptr<io::BenchIo> backend;
+  std::unique_ptr<io::DeviceIo> backend;
   if (!open_run_io(io_path, app, sched, &cfg, &backend)) return 2;
   rt::Runtime runtime(app, sched, backend.get());
   runtime.machine().set_native(o.native);

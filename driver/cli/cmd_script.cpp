@@ -12,7 +12,7 @@
 #include "commands.hpp"
 #include "common/duration.hpp"
 #include "engine.hpp"
-#include "io/bench/bench_io.hpp"
+#include "io/devices/device_io.hpp"
 #include "io/io_config.hpp"
 #include "io/link_fault.hpp"
 #include "io/sim/plant_factory.hpp"
@@ -369,20 +369,20 @@ bool script_schedule(const po::variables_map& vm, const st::Application& app, rt
 struct Target {
   std::unique_ptr<io::SimBackend> sim;
   std::unique_ptr<io::LinkFaultBackend> link;
-  std::unique_ptr<io::BenchIo> bench_io;
+  std::unique_ptr<io::DeviceIo> device_io;
   io::IoConfig cfg;
   std::string where;  // the plant, or the io file
   rt::IoBackend* backend = nullptr;
 };
 
-bool open_bench(const po::variables_map& vm, const st::Application& app, const rt::Schedule& sched, Target* t) {
+bool open_devices(const po::variables_map& vm, const st::Application& app, const rt::Schedule& sched, Target* t) {
   std::string err;
   if (!io::load_io_config(vm["io"].as<std::string>(), app, &t->cfg, &err) ||
-      !(t->bench_io = io::BenchIo::open(t->cfg, sched.tick_ns(), &err))) {
+      !(t->device_io = io::DeviceIo::open(t->cfg, sched.tick_ns(), &err))) {
     std::cerr << err << "\n";
     return false;
   }
-  t->backend = t->bench_io.get();
+  t->backend = t->device_io.get();
   t->where = "bench I/O " + t->cfg.path;
   return true;
 }
@@ -427,7 +427,7 @@ bool open_target(const po::variables_map& vm, const st::Application& app, const 
     std::cerr << "plcfi script: --io runs on the bench's devices; --plant, --plant-config and --link-status are for the plant model\n";
     return false;
   }
-  return bench ? open_bench(vm, app, sched, t) : open_plant_link(vm, app, t);
+  return bench ? open_devices(vm, app, sched, t) : open_plant_link(vm, app, t);
 }
 
 // The scripts' names resolved in the program and among the link's devices.
@@ -478,7 +478,7 @@ int choose_scripts(const Selection& sel, const std::vector<script::Script>& pars
 // Every way out once the devices are open: the safe output state reaches them first.
 struct SafeExit {
   rt::Runtime& rt;
-  io::BenchIo* io;
+  io::DeviceIo* io;
   ~SafeExit() {
     if (!io) return;
     rt.write_safe_outputs();
@@ -509,9 +509,9 @@ bool make_log_dir(const std::string& log_dir) {
 // lost devices; a way out it takes ends the run undecidable, with its reason. Null when the
 // runs are not paced.
 std::unique_ptr<rt::ScanLoop> paced_loop(bool paced, rt::Runtime& runtime, const rt::StopSignals& signals,
-                                         io::BenchIo* bench_io, script::RunOptions* ro) {
+                                         io::DeviceIo* device_io, script::RunOptions* ro) {
   if (!paced) return nullptr;
-  auto loop = std::make_unique<rt::ScanLoop>(runtime, true, &signals, [bench_io] { return bench_io ? bench_io->lost() : std::string(); });
+  auto loop = std::make_unique<rt::ScanLoop>(runtime, true, &signals, [device_io] { return device_io ? device_io->lost() : std::string(); });
   ro->scan = [l = loop.get()](rt::Runtime&, std::string* why) {
     if (l->check_stop() != rt::LoopEnd::None) {
       *why = l->end_reason();
@@ -662,8 +662,8 @@ int cmd_script(const std::vector<std::string>& args) {
   std::vector<size_t> chosen;
   if (int s = choose_scripts(a.sel, parsed, &chosen); s >= 0) return s;
   rt::Runtime runtime(app, sched, t.backend);
-  if (t.bench_io) runtime.set_safe_state(t.cfg.safe_state);
-  SafeExit safe_exit{runtime, t.bench_io.get()};
+  if (t.device_io) runtime.set_safe_state(t.cfg.safe_state);
+  SafeExit safe_exit{runtime, t.device_io.get()};
   std::unique_ptr<st::NativeCode> native;
   if (vm.count("native") && !(native = load_native(app, "plcfi script"))) return 2;
   runtime.machine().set_native(native.get());
@@ -677,7 +677,7 @@ int cmd_script(const std::vector<std::string>& args) {
   a.ro.signals = &signals;
   Session x{*b, runtime, *t.backend, *history, a, log_dir, script::program_hash(*b), vm["seed"].as<Count>().value, nullptr};
   std::cout << fmt::format("plcfi script: {} on {}, history {}\n", a.programs.front(), t.where, history_path);
-  auto loop = paced_loop(t.bench_io || vm.count("realtime"), runtime, signals, t.bench_io.get(), &a.ro);
+  auto loop = paced_loop(t.device_io || vm.count("realtime"), runtime, signals, t.device_io.get(), &a.ro);
   x.loop = loop.get();
   std::vector<testing::TestSuite> suites;
   if (!run_scripts(x, chosen, parsed, bound, {{"io", t.where}, {"history", history_path}}, signals, &suites)) return 2;

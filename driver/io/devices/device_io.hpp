@@ -1,4 +1,4 @@
-// The I/O of a bench run: every backend an `io:` section names (Modbus units, GPIO chips)
+// The devices of a run on real I/O (a bench): every backend an `io:` section names (Modbus units, GPIO chips)
 // behind one IoBackend, plus what the run loop needs to know about them: whether a
 // device has been lost for longer than allowed, and their statistics for the end report.
 #pragma once
@@ -15,11 +15,11 @@ namespace plcfi::io {
 class ModbusBackend;
 class GpioBackend;
 
-class BenchIo final : public rt::IoBackend {
+class DeviceIo final : public rt::IoBackend {
  public:
   // Opens (GPIO) or prepares (Modbus: connects in the first read) every backend of cfg.
-  static std::unique_ptr<BenchIo> open(const IoConfig& cfg, int64_t cycle_ns, std::string* err);
-  ~BenchIo() override;
+  static std::unique_ptr<DeviceIo> open(const IoConfig& cfg, int64_t cycle_ns, std::string* err);
+  ~DeviceIo() override;
 
   const std::string& name() const override { return name_; }
   uint32_t input_extent() const override;
@@ -46,7 +46,7 @@ class BenchIo final : public rt::IoBackend {
   void close();
 
  private:
-  BenchIo() = default;
+  DeviceIo() = default;
   IoConfig cfg_;
   template <typename Op>
   bool each_part(Op op);

@@ -1,5 +1,5 @@
 // Bench I/O: Modbus and GPIO backends combined.
-#include "bench_io.hpp"
+#include "device_io.hpp"
 
 #include <algorithm>
 
@@ -14,8 +14,8 @@
 
 namespace plcfi::io {
 
-std::unique_ptr<BenchIo> BenchIo::open(const IoConfig& cfg, int64_t cycle_ns, std::string* err) {
-  std::unique_ptr<BenchIo> b(new BenchIo());
+std::unique_ptr<DeviceIo> DeviceIo::open(const IoConfig& cfg, int64_t cycle_ns, std::string* err) {
+  std::unique_ptr<DeviceIo> b(new DeviceIo());
   b->cfg_ = cfg;
   if (!cfg.devices.empty()) {
 #ifdef PLCFI_HAVE_MODBUS
@@ -41,15 +41,15 @@ std::unique_ptr<BenchIo> BenchIo::open(const IoConfig& cfg, int64_t cycle_ns, st
   return b;
 }
 
-BenchIo::~BenchIo() { close(); }
+DeviceIo::~DeviceIo() { close(); }
 
-uint32_t BenchIo::input_extent() const {
+uint32_t DeviceIo::input_extent() const {
   uint32_t e = 0;
   for (auto* p : parts_) e = std::max(e, p->input_extent());
   return e;
 }
 
-uint32_t BenchIo::output_extent() const {
+uint32_t DeviceIo::output_extent() const {
   uint32_t e = 0;
   for (auto* p : parts_) e = std::max(e, p->output_extent());
   return e;
@@ -57,7 +57,7 @@ uint32_t BenchIo::output_extent() const {
 
 // Every part does `op`; false if any failed, with the last failure's error kept.
 template <typename Op>
-bool BenchIo::each_part(Op op) {
+bool DeviceIo::each_part(Op op) {
   bool ok = true;
   for (auto* p : parts_)
     if (!op(*p)) {
@@ -67,36 +67,36 @@ bool BenchIo::each_part(Op op) {
   return ok;
 }
 
-bool BenchIo::read(uint8_t* inputs, int64_t now_ns) {
+bool DeviceIo::read(uint8_t* inputs, int64_t now_ns) {
   return each_part([&](rt::IoBackend& p) { return p.read(inputs, now_ns); });
 }
 
-bool BenchIo::write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) {
+bool DeviceIo::write(const uint8_t* outputs, int64_t now_ns, int64_t dt_ns) {
   return each_part([&](rt::IoBackend& p) { return p.write(outputs, now_ns, dt_ns); });
 }
 
-bool BenchIo::write_final(const uint8_t* outputs, int64_t now_ns) {
+bool DeviceIo::write_final(const uint8_t* outputs, int64_t now_ns) {
   return each_part([&](rt::IoBackend& p) { return p.write_final(outputs, now_ns); });
 }
 
-std::vector<std::string> BenchIo::link_devices() const {
+std::vector<std::string> DeviceIo::link_devices() const {
   std::vector<std::string> d;
   for (const auto* p : parts_)
     for (auto& n : p->link_devices()) d.push_back(std::move(n));
   return d;
 }
 
-bool BenchIo::break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) {
+bool DeviceIo::break_link(const std::string& device, int64_t from_ns, int64_t duration_ns) {
   for (auto* p : parts_)
     if (p->break_link(device, from_ns, duration_ns)) return true;
   return false;
 }
 
-void BenchIo::reset(uint64_t seed) {
+void DeviceIo::reset(uint64_t seed) {
   for (auto* p : parts_) p->reset(seed);
 }
 
-std::string BenchIo::lost() const {
+std::string DeviceIo::lost() const {
 #ifdef PLCFI_HAVE_MODBUS
   if (modbus_) {
     size_t d = modbus_->lost_device();
@@ -106,7 +106,7 @@ std::string BenchIo::lost() const {
   return "";
 }
 
-std::vector<std::string> BenchIo::report() const {
+std::vector<std::string> DeviceIo::report() const {
   std::vector<std::string> out;
 #ifdef PLCFI_HAVE_MODBUS
   if (modbus_)
@@ -126,7 +126,7 @@ std::vector<std::string> BenchIo::report() const {
   return out;
 }
 
-void BenchIo::close() {
+void DeviceIo::close() {
 #ifdef PLCFI_HAVE_MODBUS
   if (modbus_) modbus_->close();
 #endif
