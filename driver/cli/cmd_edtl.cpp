@@ -89,7 +89,7 @@ int cmd_edtl(const std::vector<std::string>& args) {
     j["requirements"] = verdicts_json(verdicts);
     std::cout << json_line(j) << "\n";
   } else {
-    std::cout << fmt::format("{}: {} states\n", files[1], state) << monitor::format_verdicts(verdicts);
+    std::cout << fmt::format("{}: {} states\n", files[1], state) << report::edtl_verdicts_text(verdicts);
   }
   if (vm.count("junit") && !report::write_junit(vm["junit"].as<std::string>(), {report::edtl_junit(files[0], verdicts)}, &err)) {
     std::cerr << "plcfi edtl check: " << err << "\n";

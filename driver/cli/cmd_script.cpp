@@ -20,6 +20,7 @@
 #include "options.hpp"
 #include "plant_model/plant.hpp"
 #include "report/junit.hpp"
+#include "report/script.hpp"
 #include "report/tests.hpp"
 #include "report/trace.hpp"
 #include "runtime/realtime.hpp"
@@ -45,64 +46,14 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return true;
 }
 
-std::string secs(int64_t ns) { return fmt::format("{:.3f}", static_cast<double>(ns) * 1e-9); }
-
-// "Undecidable", "Passed", "Failed": the words of the published history table.
-std::string title(const std::string& verdict) {
-  std::string t = verdict;
-  if (!t.empty()) t[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(t[0])));
-  return t;
-}
-
-// The log of a run as text: every command, LOG line and snapshot, with the scan clock.
-bool write_text_log(const std::string& path, const script::ScriptResult& r, std::string* err) {
+// Writes a report text to path; false with "PATH: ..." in *err.
+bool write_log(const std::string& path, const std::string& text, std::string* err) {
   std::ofstream o(path);
   if (!o) {
     *err = path + ": cannot write";
     return false;
   }
-  o << fmt::format("# {}: {}{}\n", r.test, script::verdict_name(r.verdict), r.reason.empty() ? "" : " (" + r.reason + ")");
-  for (const auto& e : r.log) {
-    std::string line = e.line ? fmt::format("line {:>3}", e.line) : std::string(8, ' ');
-    const char* kind = e.kind == script::LogEntry::Kind::Command    ? "CMD "
-                       : e.kind == script::LogEntry::Kind::Log      ? "LOG "
-                       : e.kind == script::LogEntry::Kind::Snapshot ? "SNAP"
-                                                                    : "END ";
-    o << fmt::format("{:>10} s  scan {:>7}  {}  {}  {}\n", secs(e.t_ns), e.scan, line, kind, e.text);
-    if (e.snapshot >= 0)
-      for (size_t i = 0; i < r.snapshot_paths.size(); ++i)
-        o << "      " << r.snapshot_paths[i] << " = " << r.snapshots[static_cast<size_t>(e.snapshot)][i] << "\n";
-  }
-  if (!o) {
-    *err = path + ": write error";
-    return false;
-  }
-  return true;
-}
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-// The snapshots as CSV, one row each, to plot the variables around a failed assertion.
-bool write_csv_log(const std::string& path, const script::ScriptResult& r, std::string* err) {
-  std::ofstream o(path);
-  if (!o) {
-    *err = path + ": cannot write";
-    return false;
-  }
-  o << "time,scan,line,event";
-  for (const auto& p : r.snapshot_paths) o << "," << csv_field(p);
-  o << "\n";
-  for (const auto& e : r.log) {
-    if (e.snapshot < 0) continue;
-    o << secs(e.t_ns) << "," << e.scan << "," << e.line << "," << csv_field(e.text);
-    for (const auto& v : r.snapshots[static_cast<size_t>(e.snapshot)]) o << "," << csv_field(v);
-    o << "\n";
-  }
+  o << text;
   if (!o) {
     *err = path + ": write error";
     return false;
@@ -162,60 +113,6 @@ bool limit_time(const Selection& sel, int64_t used_ns, script::RunOptions* ro) {
 
 std::string not_started(const Selection& sel) {
   return fmt::format("the run's time-out ({}) ran out before this script started", common::format_duration(sel.timeout_ns));
-}
-
-// A run's text report: the verdict with its duration on the scan clock, then why it did
-// not pass.
-void print_run(const script::Script& s, const script::ScriptResult& r, const std::vector<std::string>& pous,
-               const script::RunOptions& ro, uint64_t failed_exchanges) {
-  std::string pou_list;
-  for (const auto& p : pous) pou_list += (pou_list.empty() ? "" : ", ") + p;
-  std::cout << fmt::format("\n[{}] {}  ({} s on the scan clock, {} scans; POUs {}; p_lst {} of the latest {})\n", s.path,
-                           title(script::verdict_name(r.verdict)), secs(r.end_ns), r.scans, pou_list.empty() ? "none" : pou_list,
-                           ro.p_lst, ro.mci.psi);
-  bool waited = false;
-  for (const auto& a : r.asserts)
-    if (a.waited) {
-      waited = true;
-      std::cout << fmt::format("  {}: {}: waited {} cycle(s) through a communication error, {}; c = {}, m_ci = {:.3g}\n",
-                               a.where, a.text, a.held ? a.cycles : a.cycles - 1, a.held ? "then it held" : "it never held",
-                               a.cycles, a.mci);
-    }
-  // The waited assertion's line says why the run ended, unless something cut its wait
-  // short (a time-out, an interrupt).
-  const bool said = waited && r.reason.rfind(r.asserts.back().where + ": ", 0) == 0;
-  if (!r.reason.empty() && !said) std::cout << "  " << r.reason << "\n";
-  if (r.verdict == script::Verdict::Undecidable && !r.asserts.empty() && r.asserts.back().has_mci)
-    std::cout << fmt::format("  possible external problem, factor = {:.3g}\n", r.asserts.back().mci);
-  if (failed_exchanges > 0) std::cout << fmt::format("  communication: {} exchange(s) failed\n", failed_exchanges);
-}
-
-// A script in the test model (what --junit reports): a suite of one test, named as
-// --filter and --list name them.
-testing::TestSuite script_suite(const script::Script& s, const std::vector<std::pair<std::string, std::string>>& run_props) {
-  testing::TestSuite suite;
-  suite.name = s.path;
-  suite.properties = run_props;
-  suite.cases.emplace_back();
-  suite.cases.back().name = s.name;
-  return suite;
-}
-
-// Its test after the run: the verdict (undecidable: neither a pass nor a failure of the
-// program), why it did not pass, its duration on the scan clock, m_ci and p_lst.
-testing::TestCase script_case(const script::Script& s, const script::ScriptResult& r, const script::HistoryRow& row,
-                              int64_t p_lst) {
-  testing::TestCase c;
-  c.name = s.name;
-  c.seconds = static_cast<double>(r.end_ns) * 1e-9;
-  c.verdict = r.verdict == script::Verdict::Failed        ? testing::Verdict::Fail
-              : r.verdict == script::Verdict::Undecidable ? testing::Verdict::Undecidable
-                                                          : testing::Verdict::Pass;
-  if (c.verdict != testing::Verdict::Pass) c.findings.push_back({"", r.reason});
-  if (c.verdict == testing::Verdict::Undecidable && row.mci) c.properties.emplace_back("m_ci", fmt::format("{:.3g}", *row.mci));
-  c.properties.emplace_back("verdict", row.verdict);
-  c.properties.emplace_back("p_lst", std::to_string(p_lst));
-  return c;
 }
 
 script::HistoryRow history_row(const script::Script& s, const script::ScriptResult& r, const std::string& prog_hash,
@@ -576,7 +473,8 @@ bool run_traced(const Session& x, const script::Script& s, const script::BoundSc
 bool write_logs(const std::string& log_dir, const script::Script& s, const script::ScriptResult& r) {
   if (log_dir.empty()) return true;
   std::string err;
-  if (!write_text_log(log_dir + "/" + s.name + ".log", r, &err) || !write_csv_log(log_dir + "/" + s.name + ".csv", r, &err)) {
+  if (!write_log(log_dir + "/" + s.name + ".log", report::script_text_log(r), &err) ||
+      !write_log(log_dir + "/" + s.name + ".csv", report::script_csv_log(r), &err)) {
     std::cerr << "plcfi script: --log: " << err << "\n";
     return false;
   }
@@ -603,14 +501,14 @@ bool run_one(const Session& x, const script::Script& s, const script::BoundScrip
   script::ScriptResult r;
   if (!run_traced(x, s, bound, &r)) return false;
   *used_ns += r.end_ns;
-  print_run(s, r, pous, ro, x.backend.failed_exchanges() - failed_before);
+  std::cout << report::script_run_text(s, r, pous, ro, x.backend.failed_exchanges() - failed_before);
   const script::HistoryRow row = history_row(s, r, x.prog_hash, pou_hash);
   if (!x.history.add(row, &err)) {
     std::cerr << "plcfi script: " << err << "\n";
     return false;
   }
   if (!write_logs(x.log_dir, s, r)) return false;
-  suite->cases.back() = script_case(s, r, row, ro.p_lst);
+  suite->cases.back() = report::script_case(s, r, row, ro.p_lst);
   return true;
 }
 
@@ -622,7 +520,7 @@ bool run_scripts(const Session& x, const std::vector<size_t>& chosen, const std:
                  std::vector<testing::TestSuite>* suites) {
   int64_t used_ns = 0;  // the scan clock of the scripts run so far (--timeout)
   for (size_t i : chosen) {
-    suites->push_back(script_suite(parsed[i], run_props));
+    suites->push_back(report::script_suite(parsed[i], run_props));
     if (!limit_time(x.a.sel, used_ns, &x.a.ro)) {
       fail_not_started(x.a.sel, parsed[i], &suites->back());
       continue;
@@ -720,16 +618,7 @@ int cmd_history(const std::vector<std::string>& args) {
     std::cout << (tests.empty() ? std::string("no runs recorded") : "no runs of " + tests[0]) << " in " << path << "\n";
     return 0;
   }
-  size_t w = 4;
-  for (const auto& r : rows) w = std::max(w, r.test.size());
-  std::cout << fmt::format("{:<{}}  {:<12} {:<20} {:>6} {:>5}  {}\n", "test", w, "verdict", "time (UTC)", "m_ci", "c", "note");
-  for (const auto& r : rows) {
-    std::string when = r.time;
-    if (when.size() >= 19) when = when.substr(0, 10) + " " + when.substr(11, 8);
-    std::string note = r.verdict == "undecidable" && r.mci ? fmt::format("possible external problem, factor = {:.3g}", *r.mci) : r.reason;
-    std::cout << fmt::format("{:<{}}  {:<12} {:<20} {:>6} {:>5}  {}\n", r.test, w, title(r.verdict), when,
-                             r.mci ? fmt::format("{:.3g}", *r.mci) : "-", r.cycles ? std::to_string(*r.cycles) : "-", note);
-  }
+  std::cout << report::history_table(rows);
   return 0;
 }
 

@@ -15,6 +15,7 @@
 #include "io/sim/sim_backend.hpp"
 #include "monitor/edtl.hpp"
 #include "plant_model/plant.hpp"
+#include "report/edtl.hpp"
 #include "report/trace.hpp"
 #include "runtime/runtime.hpp"
 
@@ -355,7 +356,7 @@ void print_sim_summary(const std::string& program, const plant::Plant& plant, ui
 int requirements_status(const po::variables_map& vm, const monitor::MonitorSet& monitors) {
   int status = 0;
   auto verdicts = monitors.verdicts();
-  std::cout << "requirements (" << vm["requirements"].as<std::string>() << "):\n" << monitor::format_verdicts(verdicts);
+  std::cout << "requirements (" << vm["requirements"].as<std::string>() << "):\n" << report::edtl_verdicts_text(verdicts);
   for (const auto& v : verdicts)
     if (v.violated()) status = 1;
   return status;

@@ -527,26 +527,6 @@ std::string cause_text(Cause c) {
   return c == Cause::Invariant ? "invariant broken" : "no reaction within the delay";
 }
 
-std::string format_verdicts(const std::vector<Verdict>& verdicts, int64_t) {
-  std::string out;
-  size_t violated = 0;
-  for (const auto& v : verdicts) {
-    violated += v.violated();
-    out += fmt::format("{:<10} {}  {}\n", v.id, v.violated() ? "VIOLATED " : "SATISFIED", v.text);
-    out += fmt::format("           triggers {}, held {}, violated {}, pending {}\n", v.triggers, v.holds, v.violated_instances,
-                       v.pending);
-    for (const auto& x : v.violations)
-      out += fmt::format("           - trigger at state {} (t={:.3f} s), violated at state {} (t={:.3f} s): {}{}\n",
-                         x.trigger_state, static_cast<double>(x.trigger_time_ns) * 1e-9, x.state,
-                         static_cast<double>(x.time_ns) * 1e-9, cause_text(x.cause),
-                         x.instances > 1 ? fmt::format(" ({} instances)", x.instances) : "");
-    if (v.violated_instances > v.violations.size() && v.violations.size() == Verdict::kMaxListed)
-      out += "           (further violations not listed)\n";
-  }
-  out += fmt::format("{} requirement(s): {} satisfied, {} violated\n", verdicts.size(), verdicts.size() - violated, violated);
-  return out;
-}
-
 bool check_trace(const RequirementsFile& reqs, const std::string& trace_path, int64_t cycle_ns, TraceCheck* out,
                  std::string* error) {
   bool is_vcd = trace_path.size() > 4 && trace_path.substr(trace_path.size() - 4) == ".vcd";

@@ -139,8 +139,6 @@ class MonitorSet {
   uint64_t state_ = 0;
 };
 
-std::string format_verdicts(const std::vector<Verdict>& v, int64_t cycle_ns = 0);
-
 // Offline: checks requirements on a CSV/VCD trace. cycle_ns: time between states when the
 // trace has no time column (CSV default 1 s), or the VCD sampling period (0: one state per
 // time stamp). On failure returns false with the rendered diagnostics or error in *error.

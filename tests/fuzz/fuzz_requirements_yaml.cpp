@@ -5,6 +5,7 @@
 
 #include "fuzz_support.hpp"
 #include "monitor/edtl.hpp"
+#include "report/edtl.hpp"
 
 namespace {
 
@@ -25,6 +26,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string err;
   if (!monitor::load_requirements(path, &reqs, &err)) return 0;
   monitor::TraceCheck result;
-  if (monitor::check_trace(reqs, g_trace, 0, &result, &err)) (void)monitor::format_verdicts(result.verdicts);
+  if (monitor::check_trace(reqs, g_trace, 0, &result, &err)) (void)report::edtl_verdicts_text(result.verdicts);
   return 0;
 }

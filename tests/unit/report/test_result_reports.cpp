@@ -9,6 +9,7 @@
 #include "campaign/spec.hpp"
 #include "report/campaign.hpp"
 #include "report/edtl.hpp"
+#include "report/script.hpp"
 #include "report/junit.hpp"
 
 namespace fs = std::filesystem;
@@ -154,4 +155,37 @@ TEST(RunReport, AFailedScanCycleCarriesWhyAndTheDevicesFigures) {
   EXPECT_EQ(s.cases[0].properties.front(), (std::pair<std::string, std::string>{"scans", "150"}));
   ASSERT_EQ(s.properties.size(), 2u);
   EXPECT_EQ(s.properties[1], (std::pair<std::string, std::string>{"io_0", "device d: 10 requests, 2 failed"}));
+}
+
+TEST(ScriptReport, LogsAndHistoryTableAsWritten) {
+  script::ScriptResult r;
+  r.test = "fill";
+  r.verdict = script::Verdict::Failed;
+  r.reason = "line 4: ASSERT level > 3 failed";
+  r.snapshot_paths = {"Main.level", "Main.note"};
+  r.snapshots = {{"2", "a,b"}};
+  r.log.push_back({script::LogEntry::Kind::Command, 10'000'000, 1, 3, "WAIT 10ms", -1});
+  r.log.push_back({script::LogEntry::Kind::Snapshot, 20'000'000, 2, 4, "SNAPSHOT", 0});
+  EXPECT_EQ(report::script_text_log(r),
+            "# fill: failed (line 4: ASSERT level > 3 failed)\n"
+            "     0.010 s  scan       1  line   3  CMD   WAIT 10ms\n"
+            "     0.020 s  scan       2  line   4  SNAP  SNAPSHOT\n"
+            "      Main.level = 2\n"
+            "      Main.note = a,b\n");
+  EXPECT_EQ(report::script_csv_log(r), "time,scan,line,event,Main.level,Main.note\n0.020,2,4,SNAPSHOT,2,\"a,b\"\n");
+
+  script::HistoryRow u;
+  u.test = "fill";
+  u.verdict = "undecidable";
+  u.time = "2026-11-25T06:40:12Z";
+  u.mci = 0.25;
+  u.cycles = 3;
+  script::HistoryRow p;
+  p.test = "drain_all";
+  p.verdict = "passed";
+  p.time = "2026-11-25T06:41:00Z";
+  EXPECT_EQ(report::history_table({u, p}),
+            "test       verdict      time (UTC)             m_ci     c  note\n"
+            "fill       Undecidable  2026-11-25 06:40:12    0.25     3  possible external problem, factor = 0.25\n"
+            "drain_all  Passed       2026-11-25 06:41:00       -     -  \n");
 }
