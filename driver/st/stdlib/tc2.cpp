@@ -1,7 +1,7 @@
 // Data types of Beckhoff's Tc2 libraries (Tc2_System, Tc2_Standard, Tc2_Utilities) that
 // TwinCAT programs use without declaring them, written from their public descriptions.
 // Under --dialect codesys an application gets the ones its sources name and do not
-// declare themselves (engine.cpp), as the library "<Tc2>".
+// declare themselves (st/build.cpp), as the library "<Tc2>".
 #include "codegen/compiler.hpp"
 
 namespace plcfi::st {

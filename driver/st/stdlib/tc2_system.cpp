@@ -3,7 +3,7 @@
 // MEMSET, MEMCMP, MEMMOVE, ADSLOGSTR, ADSLOGDINT, ADSLOGLREAL and TIME() are built-ins
 // (sema/stdfuncs.cpp, vm/cpp_functions.cpp) because they reach memory, the log or the clock.
 // Under --dialect codesys an application gets the items its sources name and do not
-// declare (engine.cpp), as the library "<Tc2_System>".
+// declare (st/build.cpp), as the library "<Tc2_System>".
 #include <algorithm>
 
 #include "codegen/compiler.hpp"
