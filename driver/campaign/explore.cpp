@@ -7,9 +7,13 @@
 
 #include <fmt/format.h>
 
+#include "common/csv.hpp"
+
 namespace plcfi::campaign {
 
 namespace {
+
+using common::csv_field;
 
 constexpr const char* kExploreProgram = "__FI_EXPLORE";
 constexpr size_t kExploreHeaderLines = 2;  // PROGRAM and VAR_OUTPUT lines
@@ -77,13 +81,6 @@ std::string substitute(std::string text, const std::map<std::string, std::string
     for (size_t p = text.find(key); p != std::string::npos; p = text.find(key, p + v.size())) text.replace(p, key.size(), v);
   }
   return text;
-}
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
 }
 
 }  // namespace

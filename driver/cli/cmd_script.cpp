@@ -222,18 +222,6 @@ bool script_args(const po::variables_map& vm, const std::string& usage, ScriptAr
   return split_files(vm, usage, a) && selection_of(vm, &a->sel) && wait_options(vm, &a->ro) && link_fault_option(vm, a);
 }
 
-// The program, compiled, its diagnostics on stderr. Null when it does not compile.
-std::unique_ptr<st::Build> compile_program(const po::variables_map& vm, const std::vector<std::string>& programs) {
-  st::CompileOptions opt;
-  apply_dialect_options(vm, &opt);
-  opt.warnings = false;
-  auto b = st::build_files(programs, opt);
-  for (const auto& e : b->io_errors) std::cerr << e << "\n";
-  std::cerr << b->diags.render_all();
-  if (!b->ok()) return nullptr;
-  return b;
-}
-
 bool load_scripts(const std::vector<std::string>& scripts, std::vector<script::Script>* parsed) {
   parsed->resize(scripts.size());
   std::string err;

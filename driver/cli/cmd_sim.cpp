@@ -157,20 +157,6 @@ bool load_requirements_of(const po::variables_map& vm, Requirements* r) {
   return true;
 }
 
-// The program (with the monitors), compiled, its diagnostics on stderr. Null when it does
-// not compile.
-std::unique_ptr<st::Build> compile_program(const po::variables_map& vm, const std::vector<std::string>& files,
-                                           const st::GeneratedSources& late) {
-  st::CompileOptions opt;
-  apply_dialect_options(vm, &opt);
-  opt.warnings = false;
-  auto b = st::build_files(files, opt, late);
-  for (const auto& e : b->io_errors) std::cerr << e << "\n";
-  std::cerr << b->diags.render_all();
-  if (!b->ok()) return nullptr;
-  return b;
-}
-
 // --duration, and the schedule: the configuration's tasks, or the program alone every
 // --cycle-time. False after printing why.
 bool sim_timing(const po::variables_map& vm, const st::Application& app, int64_t* duration, rt::Schedule* sched) {

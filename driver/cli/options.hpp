@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include <boost/program_options.hpp>
 #include <fmt/format.h>
 
+#include "build.hpp"
 #include "codegen/compiler.hpp"
 #include "import/import.hpp"
 
@@ -143,6 +145,20 @@ inline void apply_dialect_options(const boost::program_options::variables_map& v
 // The values of a repeatable string option or of the plain arguments; empty when absent.
 inline std::vector<std::string> strings_of(const boost::program_options::variables_map& vm, const char* key) {
   return vm.count(key) ? vm[key].as<std::vector<std::string>>() : std::vector<std::string>{};
+}
+
+// The program (with `late`: monitors, preconditions) compiled with the dialect and library
+// options and without warnings, its diagnostics on stderr. Null when it does not compile.
+inline std::unique_ptr<st::Build> compile_program(const boost::program_options::variables_map& vm,
+                                                  const std::vector<std::string>& files, const st::GeneratedSources& late = {}) {
+  st::CompileOptions opt;
+  apply_dialect_options(vm, &opt);
+  opt.warnings = false;
+  auto b = st::build_files(files, opt, late);
+  for (const auto& e : b->io_errors) std::cerr << e << "\n";
+  std::cerr << b->diags.render_all();
+  if (!b->ok()) return nullptr;
+  return b;
 }
 
 }  // namespace plcfi::cli

@@ -8,12 +8,14 @@
 
 #include <fmt/format.h>
 
+#include "common/csv.hpp"
 #include "common/json.hpp"
 
 namespace plcfi::report {
 
 namespace {
 
+using common::csv_field;
 using common::Json;
 
 Json ms_json(int64_t ns) {
@@ -25,13 +27,6 @@ std::string percent(double fraction) { return fmt::format("{:.1f} %", fraction *
 
 // A rate as written: 1400, 12.5.
 std::string fit(double v) { return fmt::format("{}", v); }
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
-  std::string o = "\"";
-  for (char c : s) o += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return o + "\"";
-}
 
 std::string exec_key(const std::string& case_id, int path) { return fmt::format("{} path {}", case_id, path); }
 

@@ -6,9 +6,13 @@
 
 #include <fmt/format.h>
 
+#include "common/csv.hpp"
+
 namespace plcfi::report {
 
 namespace {
+
+using common::csv_field;
 
 std::string secs(int64_t ns) { return fmt::format("{:.3f}", static_cast<double>(ns) * 1e-9); }
 
@@ -17,13 +21,6 @@ std::string title(const std::string& verdict) {
   std::string t = verdict;
   if (!t.empty()) t[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(t[0])));
   return t;
-}
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
 }
 
 }  // namespace
