@@ -23,6 +23,29 @@ inline void st(uint8_t* p, T v) {
   std::memcpy(p, &v, sizeof(T));
 }
 
+// A block move whose size is only known at run time (a structure, an array slice): up to
+// 16 bytes as two overlapping loads and two stores, the loads first, so that overlapping
+// source and destination behave as memmove; larger blocks go to memmove. Structures of a
+// few fields are the common case, and a call to the C library costs more than the move.
+inline void move_block(uint8_t* dst, const uint8_t* src, size_t n) {
+  if (n >= 8 && n <= 16) {
+    const uint64_t head = ld<uint64_t>(src), tail = ld<uint64_t>(src + n - 8);
+    st<uint64_t>(dst, head);
+    st<uint64_t>(dst + n - 8, tail);
+  } else if (n >= 4 && n < 8) {
+    const uint32_t head = ld<uint32_t>(src), tail = ld<uint32_t>(src + n - 4);
+    st<uint32_t>(dst, head);
+    st<uint32_t>(dst + n - 4, tail);
+  } else if (n > 0 && n < 4) {
+    const uint8_t b0 = src[0], b1 = src[n / 2], b2 = src[n - 1];
+    dst[0] = b0;
+    dst[n / 2] = b1;
+    dst[n - 1] = b2;
+  } else if (n > 16) {
+    std::memmove(dst, src, n);
+  }
+}
+
 __extension__ typedef unsigned __int128 U128;  // one MUL on x86-64 and AArch64
 
 // Two's-complement wraparound without undefined behaviour (IEC integer overflow wraps).

@@ -548,27 +548,27 @@ L_MOV1: W(uint8_t, 1, R(uint8_t, 2)); NEXT(2);
 L_MOV2: W(uint16_t, 1, R(uint16_t, 2)); NEXT(2);
 L_MOV4: W(uint32_t, 1, R(uint32_t, 2)); NEXT(2);
 L_MOV8: W(uint64_t, 1, R(uint64_t, 2)); NEXT(2);
-L_MOVN: std::memmove(base + pc[1], base + pc[2], pc[3]); NEXT(3);
+L_MOVN: move_block(base + pc[1], base + pc[2], pc[3]); NEXT(3);
 L_LDG1: W(uint8_t, 1, ld<uint8_t>(mem + pc[2])); NEXT(2);
 L_LDG2: W(uint16_t, 1, ld<uint16_t>(mem + pc[2])); NEXT(2);
 L_LDG4: W(uint32_t, 1, ld<uint32_t>(mem + pc[2])); NEXT(2);
 L_LDG8: W(uint64_t, 1, ld<uint64_t>(mem + pc[2])); NEXT(2);
-L_LDGN: std::memmove(base + pc[1], mem + pc[2], pc[3]); NEXT(3);
+L_LDGN: move_block(base + pc[1], mem + pc[2], pc[3]); NEXT(3);
 L_STG1: st<uint8_t>(mem + pc[1], R(uint8_t, 2)); NEXT(2);
 L_STG2: st<uint16_t>(mem + pc[1], R(uint16_t, 2)); NEXT(2);
 L_STG4: st<uint32_t>(mem + pc[1], R(uint32_t, 2)); NEXT(2);
 L_STG8: st<uint64_t>(mem + pc[1], R(uint64_t, 2)); NEXT(2);
-L_STGN: std::memmove(mem + pc[1], base + pc[2], pc[3]); NEXT(3);
+L_STGN: move_block(mem + pc[1], base + pc[2], pc[3]); NEXT(3);
 L_LDI1: { PTR(p, 2, pc[3], 1); W(uint8_t, 1, ld<uint8_t>(mem + p)); NEXT(3); }
 L_LDI2: { PTR(p, 2, pc[3], 2); W(uint16_t, 1, ld<uint16_t>(mem + p)); NEXT(3); }
 L_LDI4: { PTR(p, 2, pc[3], 4); W(uint32_t, 1, ld<uint32_t>(mem + p)); NEXT(3); }
 L_LDI8: { PTR(p, 2, pc[3], 8); W(uint64_t, 1, ld<uint64_t>(mem + p)); NEXT(3); }
-L_LDIN: { PTR(p, 2, pc[3], pc[4]); std::memmove(base + pc[1], mem + p, pc[4]); NEXT(4); }
+L_LDIN: { PTR(p, 2, pc[3], pc[4]); move_block(base + pc[1], mem + p, pc[4]); NEXT(4); }
 L_STI1: { PTR(p, 1, pc[2], 1); st<uint8_t>(mem + p, R(uint8_t, 3)); NEXT(3); }
 L_STI2: { PTR(p, 1, pc[2], 2); st<uint16_t>(mem + p, R(uint16_t, 3)); NEXT(3); }
 L_STI4: { PTR(p, 1, pc[2], 4); st<uint32_t>(mem + p, R(uint32_t, 3)); NEXT(3); }
 L_STI8: { PTR(p, 1, pc[2], 8); st<uint64_t>(mem + p, R(uint64_t, 3)); NEXT(3); }
-L_STIN: { PTR(p, 1, pc[2], pc[4]); std::memmove(mem + p, base + pc[3], pc[4]); NEXT(4); }
+L_STIN: { PTR(p, 1, pc[2], pc[4]); move_block(mem + p, base + pc[3], pc[4]); NEXT(4); }
 L_LDBIT: W(uint8_t, 1, static_cast<uint8_t>((mem[pc[2]] >> pc[3]) & 1u)); NEXT(3);
 L_STBIT: {
   uint8_t m = static_cast<uint8_t>(1u << pc[2]);
@@ -588,7 +588,7 @@ L_ELEM: {
   W(uint32_t, 1, static_cast<uint32_t>(p));
   NEXT(6);
 }
-L_INITBLK: std::memcpy(base + pc[1], mem + pc[2], pc[3]); NEXT(3);
+L_INITBLK: move_block(base + pc[1], mem + pc[2], pc[3]); NEXT(3);
 L_NOW: W(int64_t, 1, now_ns_); NEXT(1);
 L_ADVTIME: now_ns_ += R(int64_t, 1); NEXT(1);
 L_SETMOCK: { PTR(p, 1, 0, 8); mem[p + 2] = 1; NEXT(1); }
@@ -840,15 +840,15 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   ELEML_IMPL(8, uint64_t)
 #undef ELEML_IMPL
 #undef ELEM_LINEAR
-  // Whole elements of structure arrays, copied as blocks (memmove, as LDIN/STIN do).
+  // Whole elements of structure arrays, copied as blocks (move_block, as LDIN/STIN do).
 L_LDXB: {
   ELEM_INDEX2(i, 3)
-  std::memmove(base + pc[1], base + pc[2] + i * pc[6] + pc[7], pc[8]);
+  move_block(base + pc[1], base + pc[2] + i * pc[6] + pc[7], pc[8]);
   NEXT(8);
 }
 L_STXB: {
   ELEM_INDEX2(i, 2)
-  std::memmove(base + pc[1] + i * pc[5] + pc[6], base + pc[7], pc[8]);
+  move_block(base + pc[1] + i * pc[5] + pc[6], base + pc[7], pc[8]);
   NEXT(8);
 }
 #undef ELEM_INDEX2
