@@ -7,6 +7,8 @@
 #include <functional>
 #include <type_traits>
 
+#include <fmt/format.h>
+
 #include "compiler_impl.hpp"
 #include "vm/memory.hpp"
 #include "syntax/parser.hpp"
@@ -20,6 +22,19 @@ SourceLoc Application::loc_of(uint32_t pc) const {
                              [](uint32_t v, const std::pair<uint32_t, SourceLoc>& e) { return v < e.first; });
   if (it == lines.begin()) return {};
   return std::prev(it)->second;
+}
+
+int32_t Application::index_shift(uint32_t pc) const {
+  auto it = std::lower_bound(index_shifts.begin(), index_shifts.end(), pc,
+                             [](const std::pair<uint32_t, int32_t>& e, uint32_t v) { return e.first < v; });
+  return it != index_shifts.end() && it->first == pc ? it->second : 0;
+}
+
+std::string Application::index_message(uint32_t pc, int64_t v, int32_t lo, uint32_t count) const {
+  const int64_t k = index_shift(pc);
+  // The index as the source computes it: v + K in DINT arithmetic (wrapping).
+  const int64_t index = k == 0 ? v : static_cast<int32_t>(static_cast<uint32_t>(static_cast<int32_t>(v)) + static_cast<uint32_t>(k));
+  return fmt::format("index {} outside {}..{}", index, int64_t{lo} + k, int64_t{lo} + k + count - 1);
 }
 
 std::string Application::where(SourceLoc loc) const {
@@ -135,6 +150,7 @@ static void drop_finished_tables(Body& b) {
   auto drop = [](auto& v) { std::remove_reference_t<decltype(v)>().swap(v); };
   drop(b.code);
   drop(b.lines);
+  drop(b.index_shifts);
   drop(b.label_pos);
   drop(b.target_fix);
   drop(b.slot_fix);
@@ -462,6 +478,7 @@ void Compiler::finish_body(Body& b, PouInfo* p, std::vector<uint32_t>* entries) 
   }
   for (EntryFix f : b.entry_fix) entry_fix_.push_back({base + f.at, f.pou, f.kind});
   for (auto [pc, loc] : b.lines) app_->lines.emplace_back(base + pc, loc);
+  for (auto [pc, k] : b.index_shifts) app_->index_shifts.emplace_back(base + pc, k);
   app_->code.insert(app_->code.end(), b.code.begin(), b.code.end());
   p->code_begin = base;
   p->code_end = static_cast<uint32_t>(app_->code.size());
@@ -858,7 +875,7 @@ std::unique_ptr<Application> Compiler::run(const std::vector<const CompilationUn
 
 bool Compiler::link(Application& app, const std::vector<const CompilationUnit*>& units) {
   // What the program was, to put it back when the new units do not compile.
-  const size_t n_code = app.code.size(), n_lines = app.lines.size(), n_image = app.init_image.size(),
+  const size_t n_code = app.code.size(), n_lines = app.lines.size(), n_shifts = app.index_shifts.size(), n_image = app.init_image.size(),
                n_pous = app.pous.size(), n_observers = app.observers.size(), n_branches = app.branches.size(),
                n_globals = app.globals.size(), n_global_syms = app.global_syms.size(),
                n_files = app.file_paths.size(), n_retain = app.retain_ranges.size(), n_type_names = app.type_names.size();
@@ -890,6 +907,7 @@ bool Compiler::link(Application& app, const std::vector<const CompilationUnit*>&
   if (diags_.has_errors()) {
     app.code.resize(n_code);
     app.lines.resize(n_lines);
+    app.index_shifts.resize(n_shifts);
     app.init_image.resize(n_image);
     app.pous.resize(n_pous);
     app.observers.resize(n_observers);

@@ -119,6 +119,10 @@ struct Place {
   // or a constant (LDXL/STXL): idx not made yet, one bounds check on the wrapped sum.
   bool has_lin = false;
   Slot lin_x, lin_m, lin_y;
+  // FrameIdx whose index was v + shift (v the DINT variable in idx, shift a small integer
+  // constant): lo holds the dimension's lower bound minus shift, so the access computes
+  // v - lo without the addition (see displaced_index).
+  int32_t shift = 0;
   // FrameIdx with two indices, each a FOR counter proven to stay inside its dimension
   // (LDXXN/STXXN: no check at run time).
   bool proven = false;
@@ -143,6 +147,7 @@ struct Body {
   std::vector<std::pair<uint32_t, SK>> slot_fix;           // (code index, kind) for Temp/Const
   std::vector<EntryFix> entry_fix;
   std::vector<uint32_t> template_fix;                      // code index -> this POU's template address
+  std::vector<std::pair<uint32_t, int32_t>> index_shifts;  // (code index, shift) of displaced accesses
   std::vector<uint8_t> consts;
   std::map<std::pair<std::string, uint32_t>, uint32_t> const_index;
   uint32_t vars_end = 0;
@@ -364,6 +369,12 @@ class Compiler {
   Place member_place(Place base, const Ident& member, SourceLoc loc);
   Place index_place(Place base, const IndexExpr& e, bool for_write);
   bool take_linear_index(Slot idx, Place* p);
+  struct Displaced {
+    const Expr* var;
+    int64_t k;
+  };
+  std::optional<Displaced> displaced_index(const Expr& e);
+  void note_shift(const Place& p);
   std::optional<Val> multiply_add(Slot a, Slot b, const Type* t);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);

@@ -392,7 +392,50 @@ namespace {
 uint32_t unchecked_field(const Place& p) {
   return static_cast<uint32_t>(static_cast<int64_t>(p.field) - int64_t{p.lo} * p.stride - int64_t{p.lo2} * p.stride2);
 }
+// Data alone: nothing in it can be called or reached through (no FB instance, reference,
+// pointer or interface), so an access to it is done where it is compiled.
+bool plain_data(const Type* t) {
+  if (!t) return false;
+  if (t->kind == TypeKind::Ref || t->kind == TypeKind::Interface) return false;
+  if (t->is_elementary() || t->is_string()) return true;
+  if (t->kind == TypeKind::Array) return plain_data(t->elem);
+  if (t->kind != TypeKind::Struct) return false;
+  for (const Field& f : t->fields)
+    if (!plain_data(f.type)) return false;
+  return true;
+}
 }  // namespace
+
+// An index v + K, K + v or v - K, v a DINT variable named as it is and K an untyped
+// integer literal of at most 2^20: the access checks v against the bounds minus K
+// (rank-1 frame arrays, see index_place), which spares the addition an instruction of
+// its own. In DINT arithmetic, v + K wraps where the source's sum wraps, so the element
+// reached and the trap are the same; a trap's message adds K back (Application::
+// index_message).
+std::optional<Compiler::Displaced> Compiler::displaced_index(const Expr& e) {
+  if (e.kind != ExprKind::Binary) return std::nullopt;
+  const auto& b = static_cast<const BinaryExpr&>(e);
+  if (b.op != BinaryOp::Add && b.op != BinaryOp::Sub) return std::nullopt;
+  const Expr* var = b.lhs.get();
+  const Expr* lit = b.rhs.get();
+  if (b.op == BinaryOp::Add && var && var->kind == ExprKind::Literal) std::swap(var, lit);
+  if (!var || !lit || var->kind != ExprKind::Name || lit->kind != ExprKind::Literal) return std::nullopt;
+  const auto& l = static_cast<const LiteralExpr&>(*lit);
+  if (l.lit != LiteralKind::Int || !l.type_prefix.empty() || l.int_value > (uint64_t{1} << 20)) return std::nullopt;
+  const Symbol* sym = lookup(canon(static_cast<const NameExpr&>(*var).name.text));
+  if (!sym || sym->kind != SymKind::Var || !sym->type || sym->type->kind != TypeKind::DInt) return std::nullopt;
+  const int64_t k = static_cast<int64_t>(l.int_value);
+  return Displaced{var, b.op == BinaryOp::Sub ? -k : k};
+}
+
+// Records the shift of the access just emitted for p, for its trap's message. Code after
+// the access was dropped when the table's last entry lies there.
+void Compiler::note_shift(const Place& p) {
+  if (p.shift == 0 || b_->last_instr >= b_->code.size()) return;
+  auto& v = b_->index_shifts;
+  while (!v.empty() && v.back().first >= b_->last_instr) v.pop_back();
+  v.emplace_back(b_->last_instr, p.shift);
+}
 
 Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
   Place bad_place;
@@ -423,9 +466,21 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
   std::vector<std::pair<size_t, Slot>> dyn;
   uint32_t idx_cvt = UINT32_MAX;
   std::optional<Slot> raw16;
+  // A displaced index (v + K) into a rank-1 frame array of data: v alone, K in the bounds.
+  // A place written after a right-hand side that may call something keeps v + K computed
+  // first, as the source orders it.
+  std::optional<Displaced> disp;
+  const bool fast_elem = (t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) ||
+                         t->elem->kind == TypeKind::Struct;
+  if (e.indices.size() == 1 && base.k == Place::K::Frame && fast_elem && plain_data(t->elem) && (!for_write || defer) &&
+      t->dims[0].lo > -(int64_t{1} << 30) && t->dims[0].hi < (int64_t{1} << 30))
+    disp = displaced_index(*e.indices[0]);
+  int32_t shift = 0;
   for (size_t i = 0; i < e.indices.size(); ++i) {
-    Val v = expr(*e.indices[i], elem(TypeKind::DInt));
+    Val v = expr(disp ? *disp->var : *e.indices[i], elem(TypeKind::DInt));
     if (!v.ok) return bad_place;
+    if (disp && v.is_const && v.c.k == ConstV::K::Int) v.c.i = static_cast<int32_t>(static_cast<uint32_t>(v.c.i) + static_cast<uint32_t>(disp->k));
+    else if (disp) shift = static_cast<int32_t>(disp->k);
     if (v.is_const) {
       if (v.c.k != ConstV::K::Int) {
         diags_.error("ST208", e.indices[i]->loc, "an array index must be an integer");
@@ -492,7 +547,8 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
       p.has_idx16 = true;
       p.idx16 = *raw16;
     }
-    p.lo = static_cast<int32_t>(t->dims[d0].lo);
+    p.shift = shift;
+    p.lo = static_cast<int32_t>(t->dims[d0].lo - shift);
     p.count = static_cast<uint32_t>(t->dims[d0].hi - t->dims[d0].lo + 1);
     // stride 0: a rank-1 array of scalars (LDX/STX); else the element's or row's size.
     const bool plain = t->elem->is_elementary() && dyn.size() == 1 && stride[d0] == esize && const_disp == 0;
@@ -515,11 +571,12 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
     p.readonly = base.readonly;
     // A place read now, or stored to after a right-hand side that runs no call, may read
     // its index's variables when it is accessed.
-    if (plain && !raw16 && (!for_write || defer)) take_linear_index(p.idx, &p);
-    // One index, a FOR counter that stays inside the dimension (see for_stmt).
+    if (plain && !raw16 && shift == 0 && (!for_write || defer)) take_linear_index(p.idx, &p);
+    // One index, a FOR counter that stays inside the dimension (see for_stmt); displaced
+    // by K, the counter's range moves by K.
     if (dyn.size() == 1 && !raw16 && !p.has_lin) {
       const CounterRange* r = proven_range(p.idx);
-      p.proven = r && r->lo >= t->dims[d0].lo && r->hi <= t->dims[d0].hi;
+      p.proven = r && r->lo + shift >= t->dims[d0].lo && r->hi + shift <= t->dims[d0].hi;
     }
     return p;
   }
@@ -711,6 +768,7 @@ Slot Compiler::addr_of(const Place& p, SourceLoc loc) {
       emit(Op::ADDR, {a, Slot{p.off, p.sk}});
       Slot t = temp(4, 4);
       emit(Op::ELEM, {t, a, frame_idx(p), static_cast<uint32_t>(p.lo), p.count, p.stride ? p.stride : p.type->size});
+      note_shift(p);
       if (p.two) {
         Slot t2 = temp(4, 4);
         emit(Op::ELEM, {t2, t, p.idx2, static_cast<uint32_t>(p.lo2), p.count2, p.stride2});
@@ -825,6 +883,7 @@ Val Compiler::load(const Place& p) {
       // A whole element (a structure, an FB instance) as one block.
       Slot t = temp_for(p.type);
       emit(Op::LDXB, {t, Slot{p.off, p.sk}, frame_idx(p), static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, p.type->size});
+      note_shift(p);
       def(t);
       v.slot = t;
       return v;
@@ -898,6 +957,7 @@ Val Compiler::load(const Place& p) {
         Op op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
         emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count});
       }
+      note_shift(p);
       def(t);
       v.slot = t;
       return v;
@@ -921,6 +981,7 @@ void Compiler::store(const Place& p, Slot src) {
   if (p.k == Place::K::FrameIdx && !t->is_elementary()) {
     if (!p.two) {
       emit(Op::STXB, {Slot{p.off, p.sk}, frame_idx(p), static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src, t->size});
+      note_shift(p);
       return;
     }
     Place ind = p;
@@ -972,42 +1033,50 @@ void Compiler::store(const Place& p, Slot src) {
         Op op = size == 1 ? Op::STXXN1 : size == 2 ? Op::STXXN2 : size == 4 ? Op::STXXN4 : Op::STXXN8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
                   p.stride2, unchecked_field(p), src});
+        note_shift(p);
         return;
       }
       if (p.two) {
         Op op = size == 1 ? Op::STXX1 : size == 2 ? Op::STXX2 : size == 4 ? Op::STXX4 : Op::STXX8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
                   p.stride2, p.field, src});
+        note_shift(p);
         return;
       }
       if (p.has_lin) {
         Op op = size == 1 ? Op::STXL1 : size == 2 ? Op::STXL2 : size == 4 ? Op::STXL4 : Op::STXL8;
         emit(op, {Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count, src});
+        note_shift(p);
         return;
       }
       if (p.has_idx16 && p.stride) {
         Op op = size == 1 ? Op::STXSH1 : size == 2 ? Op::STXSH2 : size == 4 ? Op::STXSH4 : Op::STXSH8;
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        note_shift(p);
         return;
       }
       if (p.has_idx16) {
         Op op = size == 1 ? Op::STXH1 : size == 2 ? Op::STXH2 : size == 4 ? Op::STXH4 : Op::STXH8;
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, src});
+        note_shift(p);
         return;
       }
       if (p.stride && p.proven) {
         Op op = size == 1 ? Op::STXSN1 : size == 2 ? Op::STXSN2 : size == 4 ? Op::STXSN4 : Op::STXSN8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        note_shift(p);
         return;
       }
       if (p.stride) {
         Op op = size == 1 ? Op::STXS1 : size == 2 ? Op::STXS2 : size == 4 ? Op::STXS4 : Op::STXS8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        note_shift(p);
         return;
       }
       Op op = p.proven ? (size == 1 ? Op::STXN1 : size == 2 ? Op::STXN2 : size == 4 ? Op::STXN4 : Op::STXN8)
                        : (size == 1 ? Op::STX1 : size == 2 ? Op::STX2 : size == 4 ? Op::STX4 : Op::STX8);
       emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, src});
+      note_shift(p);
       return;
     }
     case Place::K::Bit: {

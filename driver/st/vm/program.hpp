@@ -187,6 +187,10 @@ class Application {
  public:
   std::vector<uint32_t> code;
   std::vector<std::pair<uint32_t, SourceLoc>> lines;  // (first pc, location), sorted by pc
+  // (pc, K) of an element access whose index was v + K for a DINT variable v: the
+  // instruction checks v against its bounds minus K. A trap's message adds K back, to
+  // name the index and bounds the source has. Sorted by pc.
+  std::vector<std::pair<uint32_t, int32_t>> index_shifts;
   std::vector<uint8_t> init_image;                     // memory at cold start
   std::vector<std::pair<uint32_t, uint32_t>> retain_ranges;  // (addr, size)
   std::vector<BranchPoint> branches;                   // index = branch id
@@ -214,6 +218,10 @@ class Application {
   uint32_t init_entry = 0, exit_entry = 0, lifecycle_addr = 0, init_flag_addr = 0;
 
   SourceLoc loc_of(uint32_t pc) const;
+  int32_t index_shift(uint32_t pc) const;  // K at pc (index_shifts), 0 when none
+  // "index I outside L..H" for the access at pc that found the index value v (as the
+  // instruction reads it) outside lo .. lo + count - 1 (as its operands say).
+  std::string index_message(uint32_t pc, int64_t v, int32_t lo, uint32_t count) const;
   std::string where(SourceLoc loc) const;  // "file:line:col"
   bool is_library_file(uint32_t file) const { return file < library_files.size() && library_files[file]; }
   PouInfo* find_pou(std::string_view name) const;

@@ -186,8 +186,7 @@ struct NativeBridge {
     std::string_view name = op_info(op).name;
     std::string msg;
     auto range = [&](int lo_at, int count_at) {
-      auto lo = static_cast<int32_t>(w[lo_at]);
-      return fmt::format("index {} outside {}..{}", a, lo, static_cast<int64_t>(lo) + w[count_at] - 1);
+      return vm.app_->index_message(pc, a, static_cast<int32_t>(w[lo_at]), w[count_at]);
     };
     bool u64 = name.size() > 4 && name.substr(name.size() - 4) == "_U64";
     auto num = [&](int64_t v) { return u64 ? std::to_string(static_cast<uint64_t>(v)) : std::to_string(v); };
@@ -582,8 +581,7 @@ L_ELEM: {
   int64_t i = static_cast<int64_t>(R(int32_t, 3)) - static_cast<int32_t>(pc[4]);
   if (i < 0 || i >= static_cast<int64_t>(pc[5]))
     return fail(TrapKind::IndexOutOfRange, pc,
-                fmt::format("index {} outside {}..{}", R(int32_t, 3), static_cast<int32_t>(pc[4]),
-                            static_cast<int64_t>(static_cast<int32_t>(pc[4])) + pc[5] - 1));
+                app_->index_message(static_cast<uint32_t>(pc - code), R(int32_t, 3), static_cast<int32_t>(pc[4]), pc[5]));
   PTR(p, 2, static_cast<uint64_t>(i) * pc[6], 0);
   W(uint32_t, 1, static_cast<uint32_t>(p));
   NEXT(6);
@@ -755,8 +753,7 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   int64_t v = static_cast<int64_t>(R(IT, k)) - static_cast<int32_t>(pc[k + 1]);                 \
   if (v < 0 || v >= static_cast<int64_t>(pc[k + 2]))                                            \
     return fail(TrapKind::IndexOutOfRange, pc,                                                  \
-                fmt::format("index {} outside {}..{}", R(IT, k), static_cast<int32_t>(pc[k + 1]), \
-                            static_cast<int64_t>(static_cast<int32_t>(pc[k + 1])) + pc[k + 2] - 1));
+                app_->index_message(static_cast<uint32_t>(pc - code), R(IT, k), static_cast<int32_t>(pc[k + 1]), pc[k + 2]));
 #define ELEM_INDEX(IT, k) ELEM_INDEX_AS(i, IT, k)
 #define ELEM_IMPL(H, IT, N, T)                                                                 \
   L_LDX##H##N: { ELEM_INDEX(IT, 3) W(T, 1, ld<T>(base + pc[2] + i * N)); NEXT(5); }            \
