@@ -191,6 +191,7 @@ void Compiler::emit_list(Op op, const std::vector<Arg>& args) {
   // after a store into a variable (the cache holds conversions of variables).
   if (op == Op::CALL || op == Op::CALLA || op == Op::CALLP || op == Op::CALLS || op == Op::CALLV || op == Op::NATIVE)
     b_->cvt_cache.clear();
+  b_->prev2_instr = b_->prev_instr < code.size() && b_->last_instr < code.size() ? b_->prev_instr : UINT32_MAX;
   b_->prev_instr = b_->last_instr < code.size() ? b_->last_instr : UINT32_MAX;
   b_->last_instr = static_cast<uint32_t>(code.size());
   code.push_back(static_cast<uint32_t>(op));

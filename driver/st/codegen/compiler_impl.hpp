@@ -160,6 +160,7 @@ struct Body {
   uint32_t last_label_pos = 0;
   uint32_t last_instr = UINT32_MAX;
   uint32_t prev_instr = UINT32_MAX;  // the instruction before last_instr, while both stand
+  uint32_t prev2_instr = UINT32_MAX;  // the instruction before prev_instr, while all three stand
   // Conversions already done in the statement being compiled (an index used twice).
   std::map<std::tuple<uint32_t, SK, Storage, Storage>, Slot> cvt_cache;
   std::unordered_map<std::string, Symbol*> locals;  // canon name -> symbol (frame or This)
@@ -374,6 +375,7 @@ class Compiler {
     int64_t k;
   };
   std::optional<Displaced> displaced_index(const Expr& e);
+  std::optional<Val> bit_of_shift();
   void note_shift(const Place& p);
   std::optional<Val> multiply_add(Slot a, Slot b, const Type* t);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);

@@ -995,7 +995,10 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   else b = operand(r, t);
   if (is_cmp(e.op)) {
     static const Op kCmp[] = {Op::LT_I8, Op::GT_I8, Op::LE_I8, Op::GE_I8, Op::EQ_I8, Op::NE_I8};
-    return emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], t, a, b, elem(TypeKind::Bool));
+    Val v = emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], t, a, b, elem(TypeKind::Bool));
+    if (e.op == BinaryOp::Eq || e.op == BinaryOp::Ne)
+      if (auto bit = bit_of_shift()) return *bit;
+    return v;
   }
   if (is_logic(e.op)) {
     if (t->is_real()) return op_error();
@@ -1052,6 +1055,68 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
     }
     default: return op_error();
   }
+}
+
+// One bit of a word as a BOOL: "SHRD s, x, n; AND m, s, 1; EQ/NE c, m, K" (K 0 or 1, the
+// three instructions just emitted one after the other, in the same line and block, each
+// reading the temporary the one before defined, all on the same integer type) is one
+// GETBITD c, x, n, inverted for "= 0" and "<> 1". The bit is what SHR and AND give: 0
+// when n is negative or not below the width. Nothing changed when it does not apply.
+std::optional<Val> Compiler::bit_of_shift() {
+  auto& code = b_->code;
+  const uint32_t cmp_at = b_->last_instr, and_at = b_->prev_instr, shr_at = b_->prev2_instr;
+  if (cmp_at >= code.size() || and_at == UINT32_MAX || shr_at == UINT32_MAX || shr_at + 4 != and_at ||
+      and_at + 4 != cmp_at || cmp_at + 4 != code.size() || shr_at < b_->last_label_pos)
+    return std::nullopt;
+  if (!b_->lines.empty() && b_->lines.back().first > shr_at) return std::nullopt;
+  // The type, from the comparison: EQ_T or NE_T over an integer storage type T.
+  constexpr uint32_t num_stride = static_cast<uint32_t>(Op::ADD_I16) - static_cast<uint32_t>(Op::ADD_I8);
+  constexpr uint32_t int_stride = static_cast<uint32_t>(Op::MOD_I16) - static_cast<uint32_t>(Op::MOD_I8);
+  const uint32_t cmp = code[cmp_at];
+  uint32_t ti = 8;
+  bool eq = false;
+  for (uint32_t k = 0; k < 8; ++k) {
+    if (cmp == static_cast<uint32_t>(Op::EQ_I8) + k * num_stride) ti = k, eq = true;
+    if (cmp == static_cast<uint32_t>(Op::NE_I8) + k * num_stride) ti = k;
+  }
+  if (ti == 8 || code[and_at] != static_cast<uint32_t>(Op::AND_I8) + ti * int_stride ||
+      code[shr_at] != static_cast<uint32_t>(Op::SHRD_I8) + ti * int_stride)
+    return std::nullopt;
+  static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8};
+  auto kind_at = [&](uint32_t word) {
+    for (const auto& [w, k] : b_->slot_fix)
+      if (w == word) return k;
+    return SK::Var;
+  };
+  // The value of the constant at an operand word (nullopt: not a constant 0 or 1).
+  auto bit_const = [&](uint32_t word) -> std::optional<uint32_t> {
+    if (kind_at(word) != SK::Const || code[word] + kWidth[ti] > b_->consts.size()) return std::nullopt;
+    uint64_t v = 0;
+    std::memcpy(&v, b_->consts.data() + code[word], kWidth[ti]);  // little-endian, as the VM reads it
+    if (v > 1) return std::nullopt;
+    return static_cast<uint32_t>(v);
+  };
+  auto temp_at = [&](uint32_t word, uint32_t def_word) {
+    return kind_at(word) == SK::Temp && kind_at(def_word) == SK::Temp && code[word] == code[def_word];
+  };
+  // AND m, s, 1 (either order) reading SHRD's s; the comparison reading m and K (either order).
+  const bool s_first = temp_at(and_at + 2, shr_at + 1) && bit_const(and_at + 3) == 1u;
+  const bool s_second = temp_at(and_at + 3, shr_at + 1) && bit_const(and_at + 2) == 1u;
+  if (!s_first && !s_second) return std::nullopt;
+  std::optional<uint32_t> k;
+  if (temp_at(cmp_at + 2, and_at + 1)) k = bit_const(cmp_at + 3);
+  else if (temp_at(cmp_at + 3, and_at + 1)) k = bit_const(cmp_at + 2);
+  if (!k) return std::nullopt;
+  // "= 1" and "<> 0" are the bit itself; "= 0" and "<> 1" its inverse.
+  const uint32_t invert = (eq ? 1u : 0u) ^ *k;
+  auto [x, n] = unemit(shr_at);
+  Slot d = temp(1, 1);
+  emit(int_op(Op::GETBITD_I8, static_cast<Storage>(ti)), {d, x, n, invert});
+  def(d);
+  Val v;
+  v.type = elem(TypeKind::Bool);
+  v.slot = d;
+  return v;
 }
 
 // A DINT sum one of whose operands is the product just computed ("MUL_I32 p, x, y" the

@@ -860,7 +860,7 @@ bool Compiler::take_linear_index(Slot idx, Place* p) {
     else ++it;
   }
   code.resize(at);
-  b_->last_instr = b_->prev_instr = b_->last_def_pos = UINT32_MAX;
+  b_->last_instr = b_->prev_instr = b_->prev2_instr = b_->last_def_pos = UINT32_MAX;
   p->has_lin = true;
   p->lin_x = x;
   p->lin_m = m;

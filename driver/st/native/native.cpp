@@ -402,6 +402,7 @@ class Translator {
         {"LOOPDN", TypedFamily::kAlways}, {"ROUND", TypedFamily::kNever}, {"TRUNC", TypedFamily::kNever},
         {"JTZ", TypedFamily::kNever},    {"JTNZ", TypedFamily::kNever},   {"SHLD", TypedFamily::kNever},
         {"SHRD", TypedFamily::kNever},   {"ROLD", TypedFamily::kNever},   {"RORD", TypedFamily::kNever},
+        {"GETBITD", TypedFamily::kNever},
     };
     size_t us = op_name.find('_');
     if (us == std::string_view::npos) return nullptr;
@@ -1036,6 +1037,8 @@ class Translator {
       std::string f(fam.substr(0, 3));
       std::transform(f.begin(), f.end(), f.begin(), [](char ch) { return static_cast<char>(ch - 'A' + 'a'); });
       s = W(C, 1, fmt::format("({}<{}>({}, dint_count({})))", f, C, R(C, 2), R("int32_t", 3)));
+    } else if (fam == "GETBITD") {
+      s = W("uint8_t", 1, fmt::format("((uint8_t)((shr<{}>({}, dint_count({})) & 1u) ^ {}))", C, R(C, 2), R("int32_t", 3), K(4)));
     } else if (fam == "CHK")
       s = fmt::format("{0} v = {1}, lo = {2}, hi = {3}; if (v < lo || v > hi) TRAP({4}, {5}, v, lo, hi);", C, R(C, 1),
                       R(C, 2), R(C, 3), w[4] == 1 ? 2 : 3, P(pc));

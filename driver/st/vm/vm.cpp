@@ -706,6 +706,9 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
   L_SHRD_##TN: W(C, 1, shr<C>(R(C, 2), dint_count(R(int32_t, 3)))); NEXT(3);             \
   L_ROLD_##TN: W(C, 1, rol<C>(R(C, 2), dint_count(R(int32_t, 3)))); NEXT(3);             \
   L_RORD_##TN: W(C, 1, ror<C>(R(C, 2), dint_count(R(int32_t, 3)))); NEXT(3);             \
+  L_GETBITD_##TN:                                                                        \
+    W(uint8_t, 1, static_cast<uint8_t>((shr<C>(R(C, 2), dint_count(R(int32_t, 3))) & 1u) ^ pc[4])); \
+    NEXT(4);                                                                             \
   L_CHK_##TN: {                                                                          \
     C v = R(C, 1), lo = R(C, 2), hi = R(C, 3);                                           \
     if ((v < lo || v > hi) && pc[4] == 1)                                                \
