@@ -375,13 +375,14 @@ class Compiler {
     int64_t k;
   };
   std::optional<Displaced> displaced_index(const Expr& e);
-  std::optional<Val> bit_of_shift();
+  std::optional<Val> bit_of_shift(bool whole_condition);
   void note_shift(const Place& p);
   std::optional<Val> multiply_add(Slot a, Slot b, const Type* t);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);
   Val load_once(const Place& p);
   Slot frame_idx(const Place& p);  // FrameIdx: the DINT index slot (made here when deferred)
+  const Expr* cond_top_ = nullptr;  // the condition cond() is compiling
   bool defer_index_cvt_ = false;  // the next index_place may leave an INT variable index as it is  // load of a place used only here (may fold its index conversion)
   void store(const Place& p, Slot src);
   void assign(const Place& dst, const Val& v, SourceLoc loc);

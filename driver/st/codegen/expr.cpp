@@ -687,6 +687,8 @@ Val Compiler::binary(const BinaryExpr& e, const Type* expected) {
     Val r = expr(*n.rhs, l.type && l.type->kind == TypeKind::Enum ? l.type : (is_cmp(n.op) ? nullptr : want[k]));
     if (!r.ok) return bad();
     l = combine(n.op, l, r, n.loc);
+    if (l.ok && (n.op == BinaryOp::Eq || n.op == BinaryOp::Ne))
+      if (auto bit = bit_of_shift(static_cast<const Expr*>(&n) == cond_top_)) l = *bit;
   }
   return l;
 }
@@ -995,10 +997,7 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   else b = operand(r, t);
   if (is_cmp(e.op)) {
     static const Op kCmp[] = {Op::LT_I8, Op::GT_I8, Op::LE_I8, Op::GE_I8, Op::EQ_I8, Op::NE_I8};
-    Val v = emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], t, a, b, elem(TypeKind::Bool));
-    if (e.op == BinaryOp::Eq || e.op == BinaryOp::Ne)
-      if (auto bit = bit_of_shift()) return *bit;
-    return v;
+    return emit_bin(kCmp[static_cast<int>(e.op) - static_cast<int>(BinaryOp::Lt)], t, a, b, elem(TypeKind::Bool));
   }
   if (is_logic(e.op)) {
     if (t->is_real()) return op_error();
@@ -1061,8 +1060,10 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
 // three instructions just emitted one after the other, in the same line and block, each
 // reading the temporary the one before defined, all on the same integer type) is one
 // GETBITD c, x, n, inverted for "= 0" and "<> 1". The bit is what SHR and AND give: 0
-// when n is negative or not below the width. Nothing changed when it does not apply.
-std::optional<Val> Compiler::bit_of_shift() {
+// when n is negative or not below the width. Nothing changed when it does not apply. (A
+// comparison with 0 that is a whole IF/WHILE condition is left to test_bits: SHRD and
+// one JTZ, two instructions as well.)
+std::optional<Val> Compiler::bit_of_shift(bool whole_condition) {
   auto& code = b_->code;
   const uint32_t cmp_at = b_->last_instr, and_at = b_->prev_instr, shr_at = b_->prev2_instr;
   if (cmp_at >= code.size() || and_at == UINT32_MAX || shr_at == UINT32_MAX || shr_at + 4 != and_at ||
@@ -1106,7 +1107,7 @@ std::optional<Val> Compiler::bit_of_shift() {
   std::optional<uint32_t> k;
   if (temp_at(cmp_at + 2, and_at + 1)) k = bit_const(cmp_at + 3);
   else if (temp_at(cmp_at + 3, and_at + 1)) k = bit_const(cmp_at + 2);
-  if (!k) return std::nullopt;
+  if (!k || (whole_condition && *k == 0)) return std::nullopt;
   // "= 1" and "<> 0" are the bit itself; "= 0" and "<> 1" its inverse.
   const uint32_t invert = (eq ? 1u : 0u) ^ *k;
   auto [x, n] = unemit(shr_at);
@@ -1165,7 +1166,10 @@ const Type* Compiler::dialect_common_type(const Type* a, const Type* b) const {
 }
 
 Val Compiler::cond(const Expr& e) {
+  const Expr* outer = cond_top_;
+  cond_top_ = &e;  // a bit test that is the whole condition stays one jump (test_bits)
   Val v = expr(e, elem(TypeKind::Bool));
+  cond_top_ = outer;
   if (!v.ok) return v;
   if (!v.type || v.type->kind != TypeKind::Bool) {
     diags_.error("ST205", e.loc, "a condition must be BOOL, not " + tname(v.type));

@@ -114,5 +114,27 @@ END_PROGRAM
   EXPECT_EQ(1, p.get("P.c"));  // 16#3D AND 1
 }
 
+// A comparison with 0 that is the whole condition of an IF stays SHRD and one JTZ/JTNZ
+// (two instructions either way); with 1, or inside a larger condition, it is a GETBITD.
+TEST(VmBits, AWholeConditionAgainstZeroStaysATestOfBits) {
+  vmtest::VmRun p(R"(PROGRAM P
+VAR x : WORD := 16#0006; k : DINT := 1; go : BOOL := TRUE; a, b, c : DINT; END_VAR
+IF (SHR(x, k) AND 1) <> 0 THEN a := 1; END_IF;
+IF (SHR(x, k) AND 1) = 1 THEN b := 1; END_IF;
+IF go AND (SHR(x, k) AND 1) = 0 THEN c := 1; END_IF;
+END_PROGRAM
+)", {}, "bits.st");
+  ASSERT_TRUE(p.ok());
+  std::string dis = p.disasm();
+  EXPECT_NE(std::string::npos, dis.find("JTZ_U16")) << dis;
+  size_t fused = 0;
+  for (size_t at = dis.find("GETBITD_U16"); at != std::string::npos; at = dis.find("GETBITD_U16", at + 1)) ++fused;
+  EXPECT_EQ(2u, fused) << dis;
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(1, p.get("P.a"));
+  EXPECT_EQ(1, p.get("P.b"));
+  EXPECT_EQ(0, p.get("P.c"));
+}
+
 }  // namespace
 }  // namespace plcfi::st
