@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
+#include "engine.hpp"
 #include "native/native.hpp"
 #include "vm/vm.hpp"
 
@@ -15,6 +18,35 @@ inline ::testing::AssertionResult same_memory(const Application& app, const Mach
   if (i == a.mem_size()) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << "memory differs at address " << i << ": " << int{a.mem()[i]} << " (interpreter) vs "
                                        << int{n.mem()[i]} << " (native)";
+}
+
+// One source (compiled as `file`) run in both tiers, scan by scan: the same result, trap,
+// memory and coverage after every scan. budget 0: the machines' default watchdog.
+// (test_vm_superinstructions.cpp has its own, which also writes inputs before each scan.)
+inline void same_in_both_tiers(const std::string& file, const std::string& src, int scans, uint64_t budget = 0) {
+  auto b = build_sources({{file, src}}, CompileOptions{});
+  ASSERT_TRUE(b->ok()) << b->diags.render_all();
+  std::string err;
+  auto native = NativeCode::build(*b->app, NativeOptions{}, &err);
+  ASSERT_TRUE(native) << err;
+  EXPECT_EQ(native->interpreted(), 0u);
+  Machine a(*b->app), n(*b->app);
+  n.set_native(native.get());
+  if (budget != 0) {
+    a.set_budget(budget);
+    n.set_budget(budget);
+  }
+  const auto& inst = b->app->programs.at(0);
+  for (int s = 0; s < scans; ++s) {
+    a.clear_taken();
+    n.clear_taken();
+    bool ra = a.call(inst.pou->entry, inst.addr);
+    bool rn = n.call(inst.pou->entry, inst.addr);
+    ASSERT_EQ(ra, rn) << "scan " << s;
+    EXPECT_EQ(describe_trap(*b->app, a.trap()), describe_trap(*b->app, n.trap())) << "scan " << s;
+    ASSERT_TRUE(same_memory(*b->app, a, n)) << "memory differs after scan " << s;
+    ASSERT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
+  }
 }
 
 }  // namespace plcfi::st

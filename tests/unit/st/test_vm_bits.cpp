@@ -82,17 +82,8 @@ TEST(VmBits, ABitOfAWordIsOneInstructionForEverySpellingAndCount) {
 
 TEST(VmBits, BitsOfWordsAgreeWithTheNativeTier) {
   for (const Width& w : kWidths) {
-    auto b = build_sources({{"bits.st", program(w.type, w.x)}}, CompileOptions{});
-    ASSERT_TRUE(b->ok()) << b->diags.render_all();
-    std::string err;
-    auto native = NativeCode::build(*b->app, NativeOptions{}, &err);
-    ASSERT_TRUE(native) << err;
-    Machine a(*b->app), n(*b->app);
-    n.set_native(native.get());
-    const auto& inst = b->app->programs.at(0);
-    ASSERT_TRUE(a.call(inst.pou->entry, inst.addr)) << a.trap().message;
-    ASSERT_TRUE(n.call(inst.pou->entry, inst.addr)) << n.trap().message;
-    EXPECT_TRUE(same_memory(*b->app, a, n)) << w.type;
+    SCOPED_TRACE(w.type);
+    same_in_both_tiers("bits.st", program(w.type, w.x), 1);
   }
 }
 

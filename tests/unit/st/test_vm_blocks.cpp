@@ -134,21 +134,7 @@ TEST(VmBlocks, StructuresOfEverySizeKeepTheirFieldsWhenMovedWhole) {
   EXPECT_EQ(4, p.get("P.a17[0].a"));           // e3.a
 }
 
-TEST(VmBlocks, StructureMovesAgreeWithTheNativeTier) {
-  auto b = build_sources({{"blocks.st", kBlocks}}, CompileOptions{});
-  ASSERT_TRUE(b->ok()) << b->diags.render_all();
-  std::string err;
-  auto native = NativeCode::build(*b->app, NativeOptions{}, &err);
-  ASSERT_TRUE(native) << err;
-  Machine a(*b->app), n(*b->app);
-  n.set_native(native.get());
-  const auto& inst = b->app->programs.at(0);
-  for (int s = 0; s < 3; ++s) {
-    ASSERT_TRUE(a.call(inst.pou->entry, inst.addr)) << a.trap().message;
-    ASSERT_TRUE(n.call(inst.pou->entry, inst.addr)) << n.trap().message;
-    ASSERT_TRUE(same_memory(*b->app, a, n)) << "memory differs after scan " << s;
-  }
-}
+TEST(VmBlocks, StructureMovesAgreeWithTheNativeTier) { same_in_both_tiers("blocks.st", kBlocks, 3); }
 
 }  // namespace
 }  // namespace plcfi::st

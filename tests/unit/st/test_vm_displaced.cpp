@@ -64,21 +64,7 @@ TEST(VmDisplaced, AnIndexPlusAConstantIsOneAccessToTheElementItNames) {
   EXPECT_EQ(50102 + (0 + 10 + 20 + 30 + 40 + 50 + 7 + 70 + 80), p.get("P.u"));
 }
 
-TEST(VmDisplaced, BothTiersAgreeOnDisplacedAccesses) {
-  auto b = build_sources({{"disp.st", kDisplaced}}, CompileOptions{});
-  ASSERT_TRUE(b->ok()) << b->diags.render_all();
-  std::string err;
-  auto native = NativeCode::build(*b->app, NativeOptions{}, &err);
-  ASSERT_TRUE(native) << err;
-  Machine a(*b->app), n(*b->app);
-  n.set_native(native.get());
-  const auto& inst = b->app->programs.at(0);
-  for (int s = 0; s < 2; ++s) {
-    ASSERT_TRUE(a.call(inst.pou->entry, inst.addr)) << a.trap().message;
-    ASSERT_TRUE(n.call(inst.pou->entry, inst.addr)) << n.trap().message;
-    ASSERT_TRUE(same_memory(*b->app, a, n)) << "memory differs after scan " << s;
-  }
-}
+TEST(VmDisplaced, BothTiersAgreeOnDisplacedAccesses) { same_in_both_tiers("disp.st", kDisplaced, 2); }
 
 // Each access traps as the sum computed into a variable first traps: same kind, message
 // and source line, in both tiers.

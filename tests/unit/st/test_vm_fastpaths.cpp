@@ -23,32 +23,6 @@ struct Prog : vmtest::VmRun {
   explicit Prog(const std::string& src) : VmRun(src, {}, "fast.st") {}
 };
 
-// Both tiers, scan by scan: same result, trap, memory, coverage.
-void same_in_both_tiers(const std::string& src, int scans, uint64_t budget = 0) {
-  auto b = build_sources({{"fast.st", src}}, CompileOptions{});
-  ASSERT_TRUE(b->ok()) << b->diags.render_all();
-  std::string err;
-  auto native = NativeCode::build(*b->app, NativeOptions{}, &err);
-  ASSERT_TRUE(native) << err;
-  EXPECT_EQ(native->interpreted(), 0u);
-  Machine a(*b->app), n(*b->app);
-  n.set_native(native.get());
-  if (budget != 0) {
-    a.set_budget(budget);
-    n.set_budget(budget);
-  }
-  const auto& inst = b->app->programs.at(0);
-  for (int s = 0; s < scans; ++s) {
-    a.clear_taken();
-    n.clear_taken();
-    bool ra = a.call(inst.pou->entry, inst.addr);
-    bool rn = n.call(inst.pou->entry, inst.addr);
-    ASSERT_EQ(ra, rn) << "scan " << s;
-    EXPECT_EQ(describe_trap(*b->app, a.trap()), describe_trap(*b->app, n.trap())) << "scan " << s;
-    ASSERT_TRUE(same_memory(*b->app, a, n)) << "memory differs after scan " << s;
-    ASSERT_EQ(a.taken(), n.taken()) << "coverage differs after scan " << s;
-  }
-}
 
 // ------------------------------------------------------------------ FUNCTION frames
 
@@ -173,7 +147,7 @@ TEST(VmFastPaths, FunctionFramesAreNotCopiedWholeWhenTheCallPassesEverything) {
   }
 }
 
-TEST(VmFastPaths, FunctionFramesBehaveTheSameInTheNativeTier) { same_in_both_tiers(kFrames, 3); }
+TEST(VmFastPaths, FunctionFramesBehaveTheSameInTheNativeTier) { same_in_both_tiers("fast.st", kFrames, 3); }
 
 // (A mocked FUNCTION's outputs: tests/st/test_call_frames.st, through `plcfi test`.)
 
@@ -254,7 +228,7 @@ WHILE x < y DO x := x + 1.0; n[5] := n[5] + 1; END_WHILE;
 IF NOT (x = y) THEN n[6] := n[6] + 1; END_IF;
 END_PROGRAM
 )";
-  same_in_both_tiers(src, 30);
+  same_in_both_tiers("fast.st", src, 30);
 }
 
 // ------------------------------------------------------------------ INT-indexed reads
@@ -350,14 +324,14 @@ TEST(VmFastPaths, IntIndexedStoresBehaveTheSameInTheNativeTier) {
   std::string src = kIntIndexStores;
   // i, j and bad walk through and past the bounds: both tiers trap alike.
   src.replace(src.find("a[i] := Bump"), 0, "i := (i + 1) MOD 6; j := (j + 1) MOD 5; bad := (bad + 1) MOD 7;\n");
-  same_in_both_tiers(src, 14);
+  same_in_both_tiers("fast.st", src, 14);
 }
 
 TEST(VmFastPaths, IntIndexedReadsBehaveTheSameInTheNativeTier) {
   std::string src = kIntIndex;
   // bad walks 0..9: scans trap at 0 and 9 in both tiers alike.
   src.replace(src.find("v := a[bad];"), 12, "bad := (bad + 1) MOD 10; v := a[bad];");
-  same_in_both_tiers(src, 12);
+  same_in_both_tiers("fast.st", src, 12);
 }
 
 // ------------------------------------------------------------------ rank-2 arrays, whole elements
@@ -425,7 +399,7 @@ TEST(VmFastPaths, RankTwoAccessBehavesTheSameInTheNativeTier) {
   std::string src = kRank2;
   // bi and bj walk through and past their bounds: both tiers trap alike, on either index.
   src.replace(src.find("x := m[bi, bj];"), 15, "bi := (bi + 1) MOD 5; bj := (bj + 2) MOD 5 - 1; x := m[bi, bj];");
-  same_in_both_tiers(src, 12);
+  same_in_both_tiers("fast.st", src, 12);
 }
 
 // ------------------------------------------------------------------ FOR counters proven in range
@@ -485,7 +459,7 @@ TEST(VmFastPaths, ForCountersInRangeNeedNoIndexCheck) {
   EXPECT_EQ(u, p.get("P.u"));
   EXPECT_EQ(9, p.get("P.m[1,-1]"));  // the lower bounds folded into the offset
   EXPECT_EQ(32, p.get("P.m[3,2]"));
-  same_in_both_tiers(kProven, 3);
+  same_in_both_tiers("fast.st", kProven, 3);
 }
 
 // Each loop below could reach outside q (or changes its counter, or may): the check stays,
@@ -543,7 +517,7 @@ VAR q : ARRAY [0..4, 0..4] OF DINT; v : ARRAY [0..4] OF DINT; i, j, s : DINT; n 
     } else {
       EXPECT_TRUE(ok) << c.what << ": " << prog.m->trap().message;
     }
-    same_in_both_tiers(src, 2);
+    same_in_both_tiers("fast.st", src, 2);
   }
 }
 
@@ -597,7 +571,7 @@ TEST(VmFastPaths, LoopsTestedAtTheBottomBehaveTheSameInTheNativeTier) {
   std::string src = kLoops;
   // spin on every fifth scan: both tiers stop on the watchdog alike.
   src.replace(src.find("n := n + 1;"), 11, "n := n + 1; spin := n MOD 5 = 0;");
-  same_in_both_tiers(src, 11, 5000);
+  same_in_both_tiers("fast.st", src, 11, 5000);
 }
 
 // ------------------------------------------------------------------ tests of bits
@@ -642,7 +616,7 @@ TEST(VmFastPaths, TestsOfBitsAreOneJump) {
   EXPECT_EQ(__builtin_popcount((2u * 7919u) & 0xFFFFu), p.get("P.ones"));
 }
 
-TEST(VmFastPaths, TestsOfBitsBehaveTheSameInTheNativeTier) { same_in_both_tiers(kBits, 20); }
+TEST(VmFastPaths, TestsOfBitsBehaveTheSameInTheNativeTier) { same_in_both_tiers("fast.st", kBits, 20); }
 
 // ------------------------------------------------------------------ shift counts
 
@@ -686,7 +660,7 @@ TEST(VmFastPaths, DintShiftCountsAreReadAsTheyAre) {
 TEST(VmFastPaths, DintShiftCountsBehaveTheSameInTheNativeTier) {
   std::string src = kShifts;
   src.replace(src.find("r1 := SHL"), 0, "n := n + 7; IF n > 70 THEN n := -70; END_IF;\n");
-  same_in_both_tiers(src, 25);
+  same_in_both_tiers("fast.st", src, 25);
 }
 
 // ------------------------------------------------------------------ indices linear in two variables
@@ -754,7 +728,7 @@ TEST(VmFastPaths, LinearIndicesBehaveTheSameInTheNativeTier) {
   // big alternates between wrapping and trapping; bad walks into and past the bounds.
   src.replace(src.find("i := 1; k := 2;"), 0,
               "IF big = 65536 THEN big := 3; ELSE big := 65536; END_IF; bad := (bad + 1) MOD 4;\n");
-  same_in_both_tiers(src, 12);
+  same_in_both_tiers("fast.st", src, 12);
 }
 
 // ------------------------------------------------------------------ multiply-accumulate
@@ -787,7 +761,7 @@ TEST(VmFastPaths, MultiplyAccumulateIsOneInstructionThatWraps) {
 TEST(VmFastPaths, MultiplyAccumulateBehavesTheSameInTheNativeTier) {
   std::string src = kMadd;
   src.replace(src.find("s := 0;"), 0, "big := big * 3 + 7; k := k + 1000;\n");
-  same_in_both_tiers(src, 20);
+  same_in_both_tiers("fast.st", src, 20);
 }
 
 }  // namespace
