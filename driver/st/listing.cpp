@@ -68,6 +68,8 @@ std::string disassemble(const Application& app, const Build* build) {
       std::string line = fmt::format("  {:6}  {:<10}", pc, info.name);
       for (uint32_t k = 1; k < len; ++k) line += fmt::format(" {}", app.code[pc + k]);
       if (static_cast<Op>(app.code[pc]) == Op::NATIVE) line += fmt::format("   ({})", native_name(app.code[pc + 1] & 0xffffu));
+      // A displaced index (v + K): its lower-bound operand is the dimension's minus K.
+      if (int32_t k = app.index_shift(pc); k != 0) line += fmt::format("   (index {} {})", k < 0 ? "-" : "+", k < 0 ? -int64_t{k} : int64_t{k});
       out += line + "\n";
     }
     pc += len;

@@ -53,6 +53,8 @@ TEST(VmDisplaced, AnIndexPlusAConstantIsOneAccessToTheElementItNames) {
   for (size_t at = dis.find("SUB_I32"); at != std::string::npos; at = dis.find("SUB_I32", at + 1)) ++subs;
   EXPECT_EQ(1u, subs) << dis;
   EXPECT_NE(std::string::npos, dis.find("LDXN4")) << dis;  // a[i - 1], i in 1..9
+  EXPECT_NE(std::string::npos, dis.find("(index - 1)")) << dis;  // the listing names K
+  EXPECT_NE(std::string::npos, dis.find("(index + 2)")) << dis;
   ASSERT_TRUE(p.scan()) << p.m->trap().message;
   EXPECT_EQ(30 + 50000 + 60000000, p.get("P.s"));
   EXPECT_EQ(10 + 100, p.get("P.t"));
