@@ -331,6 +331,10 @@ class Compiler {
   // (Defined in stmt.cpp.)
   void branch_on(const Val& c, SourceLoc loc, Label target, bool when_true);
   bool test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero);
+  // For the peepholes that read code just emitted: the slot kind of the operand at a code
+  // word, and the value of a constant pool slot of `width` bytes there (nullopt: none).
+  SK kind_at(uint32_t word) const;
+  std::optional<uint64_t> const_at(uint32_t word, uint32_t width) const;
   std::pair<Arg, Arg> unemit(uint32_t at);
   Val bad() {
     Val v;

@@ -1084,18 +1084,11 @@ std::optional<Val> Compiler::bit_of_shift(bool whole_condition) {
       code[shr_at] != static_cast<uint32_t>(Op::SHRD_I8) + ti * int_stride)
     return std::nullopt;
   static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8};
-  auto kind_at = [&](uint32_t word) {
-    for (const auto& [w, k] : b_->slot_fix)
-      if (w == word) return k;
-    return SK::Var;
-  };
   // The value of the constant at an operand word (nullopt: not a constant 0 or 1).
   auto bit_const = [&](uint32_t word) -> std::optional<uint32_t> {
-    if (kind_at(word) != SK::Const || code[word] + kWidth[ti] > b_->consts.size()) return std::nullopt;
-    uint64_t v = 0;
-    std::memcpy(&v, b_->consts.data() + code[word], kWidth[ti]);  // little-endian, as the VM reads it
-    if (v > 1) return std::nullopt;
-    return static_cast<uint32_t>(v);
+    std::optional<uint64_t> v = const_at(word, kWidth[ti]);
+    if (!v || *v > 1) return std::nullopt;
+    return static_cast<uint32_t>(*v);
   };
   auto temp_at = [&](uint32_t word, uint32_t def_word) {
     return kind_at(word) == SK::Temp && kind_at(def_word) == SK::Temp && code[word] == code[def_word];

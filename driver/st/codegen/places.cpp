@@ -470,8 +470,9 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
   // A place written after a right-hand side that may call something keeps v + K computed
   // first, as the source orders it.
   std::optional<Displaced> disp;
+  // Elements the fast path (below) reaches in one instruction.
   const bool fast_elem = (t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) ||
-                         t->elem->kind == TypeKind::Struct;
+                         t->elem->kind == TypeKind::Struct || t->elem->kind == TypeKind::Pou;
   if (e.indices.size() == 1 && base.k == Place::K::Frame && fast_elem && plain_data(t->elem) && (!for_write || defer) &&
       t->dims[0].lo > -(int64_t{1} << 30) && t->dims[0].hi < (int64_t{1} << 30))
     disp = displaced_index(*e.indices[0]);
@@ -524,9 +525,7 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
   // Fast path: one or two variable indices into a frame array, of any rank, of scalars or
   // of structures (whose scalar fields are then reached in one instruction). The constant
   // indices make a fixed offset into the element's row.
-  const bool fast = (dyn.size() == 1 || dyn.size() == 2) && base.k == Place::K::Frame &&
-                    ((t->elem->is_elementary() && (esize == 1 || esize == 2 || esize == 4 || esize == 8)) ||
-                     t->elem->kind == TypeKind::Struct || t->elem->kind == TypeKind::Pou);
+  const bool fast = (dyn.size() == 1 || dyn.size() == 2) && base.k == Place::K::Frame && fast_elem;
   if (raw16 && !fast) dyn[0].second = convert(*raw16, elem(TypeKind::Int), elem(TypeKind::DInt));
   if (dyn.empty()) {
     Place p = base;
@@ -846,11 +845,7 @@ bool Compiler::take_linear_index(Slot idx, Place* p) {
   const uint32_t at = b_->last_instr;
   if (at >= code.size() || code[at] != static_cast<uint32_t>(Op::MADD_I32) || at < b_->last_label_pos) return false;
   if (!b_->lines.empty() && b_->lines.back().first > at) return false;
-  auto slot_at = [&](uint32_t word) {
-    for (const auto& [w, k] : b_->slot_fix)
-      if (w == word) return Slot{code[word], k};
-    return Slot{code[word], SK::Var};
-  };
+  auto slot_at = [&](uint32_t word) { return Slot{code[word], kind_at(word)}; };
   auto operand = [](Slot s) { return s.kind == SK::Var || s.kind == SK::Const; };
   const Slot sum = slot_at(at + 1), x = slot_at(at + 2), m = slot_at(at + 3), y = slot_at(at + 4);
   if (idx.kind != SK::Temp || sum.kind != SK::Temp || sum.off != idx.off) return false;
@@ -1033,32 +1028,27 @@ void Compiler::store(const Place& p, Slot src) {
         Op op = size == 1 ? Op::STXXN1 : size == 2 ? Op::STXXN2 : size == 4 ? Op::STXXN4 : Op::STXXN8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
                   p.stride2, unchecked_field(p), src});
-        note_shift(p);
         return;
       }
       if (p.two) {
         Op op = size == 1 ? Op::STXX1 : size == 2 ? Op::STXX2 : size == 4 ? Op::STXX4 : Op::STXX8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
                   p.stride2, p.field, src});
-        note_shift(p);
         return;
       }
       if (p.has_lin) {
         Op op = size == 1 ? Op::STXL1 : size == 2 ? Op::STXL2 : size == 4 ? Op::STXL4 : Op::STXL8;
         emit(op, {Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count, src});
-        note_shift(p);
         return;
       }
       if (p.has_idx16 && p.stride) {
         Op op = size == 1 ? Op::STXSH1 : size == 2 ? Op::STXSH2 : size == 4 ? Op::STXSH4 : Op::STXSH8;
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
-        note_shift(p);
         return;
       }
       if (p.has_idx16) {
         Op op = size == 1 ? Op::STXH1 : size == 2 ? Op::STXH2 : size == 4 ? Op::STXH4 : Op::STXH8;
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, src});
-        note_shift(p);
         return;
       }
       if (p.stride && p.proven) {

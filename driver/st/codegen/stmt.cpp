@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <set>
 
+#include <cstring>
+
 #include "compiler_impl.hpp"
 
 namespace plcfi::st::detail {
@@ -50,6 +52,21 @@ std::pair<Arg, Arg> Compiler::unemit(uint32_t at) {
   return {x, y};
 }
 
+SK Compiler::kind_at(uint32_t word) const {
+  for (const auto& [w, k] : b_->slot_fix)
+    if (w == word) return k;
+  return SK::Var;
+}
+
+std::optional<uint64_t> Compiler::const_at(uint32_t word, uint32_t width) const {
+  const auto& code = b_->code;
+  if (word >= code.size() || kind_at(word) != SK::Const || width > 8 || uint64_t{code[word]} + width > b_->consts.size())
+    return std::nullopt;
+  uint64_t v = 0;
+  std::memcpy(&v, b_->consts.data() + code[word], width);  // little-endian, as the VM reads it
+  return v;
+}
+
 // A test of bits: "AND t, x, m; EQ/NE c, t, 0" compiled into a jump is one JTZ or JTNZ
 // on x and m, when the AND is the instruction right before the comparison, in the same
 // statement line and block, and defines a temporary only the comparison reads. `if_zero`:
@@ -62,17 +79,7 @@ bool Compiler::test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool 
   if (code[and_at] != static_cast<uint32_t>(Op::AND_I8) + type_idx * stride || and_at + 4 != cmp_at) return false;
   if (!b_->lines.empty() && b_->lines.back().first > and_at) return false;
   static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8};
-  auto kind_at = [&](uint32_t word) {
-    for (const auto& [w, k] : b_->slot_fix)
-      if (w == word) return k;
-    return SK::Var;
-  };
-  auto zero = [&](uint32_t word) {
-    if (kind_at(word) != SK::Const || code[word] + kWidth[type_idx] > b_->consts.size()) return false;
-    for (uint32_t i = 0; i < kWidth[type_idx]; ++i)
-      if (b_->consts[code[word] + i] != 0) return false;
-    return true;
-  };
+  auto zero = [&](uint32_t word) { return const_at(word, kWidth[type_idx]) == uint64_t{0}; };
   // The comparison reads the AND's temporary and a constant zero, in either order.
   const uint32_t t = code[and_at + 1];
   if (kind_at(and_at + 1) != SK::Temp) return false;

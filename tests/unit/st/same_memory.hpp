@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 
 #include "engine.hpp"
@@ -22,8 +23,9 @@ inline ::testing::AssertionResult same_memory(const Application& app, const Mach
 
 // One source (compiled as `file`) run in both tiers, scan by scan: the same result, trap,
 // memory and coverage after every scan. budget 0: the machines' default watchdog.
-// (test_vm_superinstructions.cpp has its own, which also writes inputs before each scan.)
-inline void same_in_both_tiers(const std::string& file, const std::string& src, int scans, uint64_t budget = 0) {
+// `inputs`, when given, writes the same inputs into both machines before each scan.
+inline void same_in_both_tiers(const std::string& file, const std::string& src, int scans, uint64_t budget = 0,
+                               const std::function<void(Machine&, int)>& inputs = nullptr) {
   auto b = build_sources({{file, src}}, CompileOptions{});
   ASSERT_TRUE(b->ok()) << b->diags.render_all();
   std::string err;
@@ -38,6 +40,10 @@ inline void same_in_both_tiers(const std::string& file, const std::string& src, 
   }
   const auto& inst = b->app->programs.at(0);
   for (int s = 0; s < scans; ++s) {
+    if (inputs) {
+      inputs(a, s);
+      inputs(n, s);
+    }
     a.clear_taken();
     n.clear_taken();
     bool ra = a.call(inst.pou->entry, inst.addr);
