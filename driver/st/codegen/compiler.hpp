@@ -26,6 +26,9 @@ struct CompileOptions {
   // the ASSERT_*/ADVANCE_TIME/MOCK_* built-ins are available.
   bool test_mode = false;
   bool warnings = true;
+  // FOR loops set the row offsets of rank-2 accesses once per entry (ROWS, LDXR/STXR);
+  // off, each access computes its whole offset (tests compare the two).
+  bool row_offsets = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

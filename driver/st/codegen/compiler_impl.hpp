@@ -126,6 +126,7 @@ struct Place {
   // FrameIdx with two indices, each a FOR counter proven to stay inside its dimension
   // (LDXXN/STXXN: no check at run time).
   bool proven = false;
+  uint32_t arr_bytes = 0;  // FrameIdx: the whole array's size, from off
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -413,10 +414,34 @@ class Compiler {
   struct CounterRange {
     Slot slot;
     int64_t lo = 0, hi = 0;
+    std::string name;  // canonical
   };
   std::vector<CounterRange> counters_;
   const CounterRange* proven_range(Slot s) const;
   bool keeps_counter(const StmtList& body, const std::string& counter) const;
+  // Rows (stmt.cpp): in a FOR loop over a proven counter, a rank-2 access indexed by the
+  // counter and by a counter of an enclosing loop reads the offset of its row (the part
+  // the loop does not change) from a slot ROWS sets on the loop's entry (LDXR/STXR).
+  struct RowOffset {
+    int64_t k = 0;   // offset (of the field, in its element) when both counters are 0
+    Slot v;          // the outer counter
+    int64_t m = 0;   // its stride
+  };
+  struct RowLoop {
+    Slot counter;
+    size_t depth = 0;           // the loop's entry in counters_
+    uint32_t at = 0;            // code index of its ROWS
+    std::vector<Slot> slots;    // reserved before the body
+    std::vector<RowOffset> used;
+  };
+  std::vector<RowLoop> row_loops_;
+  size_t row_candidates(const StmtList& body, const std::string& counter, std::vector<std::string>* inner) const;
+  struct RowAccess {
+    Slot row, counter;
+    int64_t m = 0;
+  };
+  // How a proven rank-2 access reaches its element through a loop's row slot, if one can.
+  std::optional<RowAccess> row_for(const Place& p);
   Val call_function(PouInfo* f, const CallExpr& c);
   // The frame set-up of a FUNCTION call: the template's bytes this call needs (calls.cpp).
   void init_function_frame(PouInfo* f, Slot frame, const std::vector<const Symbol*>& stored);

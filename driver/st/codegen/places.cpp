@@ -567,6 +567,7 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
                  r1->lo >= t->dims[d1].lo && r1->hi <= t->dims[d1].hi;
     }
     p.idx_cvt = idx_cvt;
+    p.arr_bytes = t->size;
     p.readonly = base.readonly;
     // A place read now, or stored to after a right-hand side that runs no call, may read
     // its index's variables when it is accessed.
@@ -926,6 +927,14 @@ Val Compiler::load(const Place& p) {
       return v;
     }
     case Place::K::FrameIdx: {
+      if (auto r = row_for(p)) {
+        Slot t = temp_for(p.type);
+        Op op = size == 1 ? Op::LDXR1 : size == 2 ? Op::LDXR2 : size == 4 ? Op::LDXR4 : Op::LDXR8;
+        emit(op, {t, r->row, r->counter, static_cast<uint32_t>(static_cast<int32_t>(r->m)), Slot{p.off, p.sk}, p.arr_bytes});
+        def(t);
+        v.slot = t;
+        return v;
+      }
       Slot idx = p.has_lin ? Slot{} : frame_idx(p);
       Slot t = temp_for(p.type);
       if (p.two && p.proven) {
@@ -1024,6 +1033,11 @@ void Compiler::store(const Place& p, Slot src) {
         default: emit(Op::STIN, {p.ptr, p.off, src, size}); return;
       }
     case Place::K::FrameIdx: {
+      if (auto r = row_for(p)) {
+        Op op = size == 1 ? Op::STXR1 : size == 2 ? Op::STXR2 : size == 4 ? Op::STXR4 : Op::STXR8;
+        emit(op, {r->row, r->counter, static_cast<uint32_t>(static_cast<int32_t>(r->m)), Slot{p.off, p.sk}, p.arr_bytes, src});
+        return;
+      }
       if (p.two && p.proven) {
         Op op = size == 1 ? Op::STXXN1 : size == 2 ? Op::STXXN2 : size == 4 ? Op::STXXN4 : Op::STXXN8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,

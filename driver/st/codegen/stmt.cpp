@@ -686,6 +686,160 @@ bool Compiler::keeps_counter(const StmtList& body, const std::string& counter) c
   return true;
 }
 
+namespace {
+// An index a row offset can be kept for: a variable, or a variable plus or minus an integer literal.
+const NameExpr* index_variable(const Expr& e) {
+  if (e.kind == ExprKind::Name) return &static_cast<const NameExpr&>(e);
+  if (e.kind != ExprKind::Binary) return nullptr;
+  const auto& b = static_cast<const BinaryExpr&>(e);
+  if (b.op != BinaryOp::Add && b.op != BinaryOp::Sub) return nullptr;
+  if (b.lhs->kind == ExprKind::Name && b.rhs->kind == ExprKind::Literal) return &static_cast<const NameExpr&>(*b.lhs);
+  if (b.op == BinaryOp::Add && b.rhs->kind == ExprKind::Name && b.lhs->kind == ExprKind::Literal)
+    return &static_cast<const NameExpr&>(*b.rhs);
+  return nullptr;
+}
+
+// `inner`: counters of FOR loops nested inside the counter's; an access by one of them is
+// theirs to keep a row for.
+// `outer`: the counters of the proven loops around the counter's, the only other index a
+// row can be kept for.
+size_t count_indexed(const Expr* e, const std::string& counter, const std::vector<std::string>& inner,
+                     const std::vector<std::string>& outer) {
+  size_t n = 0;
+  while (e) {
+    switch (e->kind) {
+      case ExprKind::Index: {
+        const auto& x = static_cast<const IndexExpr&>(*e);
+        bool by_counter = false, by_outer = false, simple = true;
+        size_t vars = 0;
+        for (const auto& i : x.indices) {
+          const NameExpr* v = index_variable(*i);
+          if (v) ++vars;
+          else if (i->kind != ExprKind::Literal) simple = false;
+          const std::string name = v ? canon(v->name.text) : std::string();
+          if (v && name == counter) by_counter = true;
+          if (v && std::find(outer.begin(), outer.end(), name) != outer.end()) by_outer = true;
+          if (v && std::find(inner.begin(), inner.end(), name) != inner.end()) simple = false;
+          n += count_indexed(i.get(), counter, inner, outer);
+        }
+        if (by_counter && by_outer && simple && vars == 2) ++n;
+        e = x.base.get();
+        break;
+      }
+      case ExprKind::Member: e = static_cast<const MemberExpr&>(*e).base.get(); break;
+      case ExprKind::BitAccess: e = static_cast<const BitAccessExpr&>(*e).base.get(); break;
+      case ExprKind::Deref: e = static_cast<const DerefExpr&>(*e).base.get(); break;
+      case ExprKind::Unary: e = static_cast<const UnaryExpr&>(*e).operand.get(); break;
+      case ExprKind::Binary: {
+        // A long chain is a deep left spine: walked in this loop, the right operands recursively.
+        const auto& b = static_cast<const BinaryExpr&>(*e);
+        n += count_indexed(b.rhs.get(), counter, inner, outer);
+        e = b.lhs.get();
+        break;
+      }
+      case ExprKind::Call: {
+        for (const auto& a : static_cast<const CallExpr&>(*e).args) n += count_indexed(a.value.get(), counter, inner, outer);
+        e = nullptr;
+        break;
+      }
+      default: e = nullptr; break;
+    }
+  }
+  return n;
+}
+}  // namespace
+
+// How many row offsets a FOR loop over `counter` may keep: the accesses in its body with
+// two variable indices (each plus or minus a literal, the others literals), one of them
+// the counter. An upper bound: the compiler decides access by access (row_for).
+size_t Compiler::row_candidates(const StmtList& body, const std::string& counter, std::vector<std::string>* inner) const {
+  std::vector<std::string> outer;
+  for (const CounterRange& c : counters_)
+    if (c.name != counter) outer.push_back(c.name);
+  size_t n = 0;
+  for (const StmtPtr& sp : body) {
+    const Stmt& st = *sp;
+    switch (st.kind) {
+      case StmtKind::Assign: {
+        const auto& a = static_cast<const AssignStmt&>(st);
+        n += count_indexed(a.lhs.get(), counter, *inner, outer) + count_indexed(a.rhs.get(), counter, *inner, outer);
+        break;
+      }
+      case StmtKind::If: {
+        const auto& i = static_cast<const IfStmt&>(st);
+        for (const auto& arm : i.arms) n += count_indexed(arm.cond.get(), counter, *inner, outer) + row_candidates(arm.body, counter, inner);
+        if (i.else_body) n += row_candidates(*i.else_body, counter, inner);
+        break;
+      }
+      case StmtKind::Case: {
+        const auto& c = static_cast<const CaseStmt&>(st);
+        n += count_indexed(c.selector.get(), counter, *inner, outer);
+        for (const auto& arm : c.arms) n += row_candidates(arm.body, counter, inner);
+        if (c.else_body) n += row_candidates(*c.else_body, counter, inner);
+        break;
+      }
+      case StmtKind::For: {
+        const auto& f = static_cast<const ForStmt&>(st);
+        n += count_indexed(f.from.get(), counter, *inner, outer) + count_indexed(f.to.get(), counter, *inner, outer) +
+             count_indexed(f.by.get(), counter, *inner, outer);
+        inner->push_back(f.var->kind == ExprKind::Name ? canon(static_cast<const NameExpr&>(*f.var).name.text) : std::string());
+        n += row_candidates(f.body, counter, inner);
+        inner->pop_back();
+        break;
+      }
+      case StmtKind::While: {
+        const auto& w = static_cast<const WhileStmt&>(st);
+        n += count_indexed(w.cond.get(), counter, *inner, outer) + row_candidates(w.body, counter, inner);
+        break;
+      }
+      case StmtKind::Repeat: {
+        const auto& r = static_cast<const RepeatStmt&>(st);
+        n += row_candidates(r.body, counter, inner) + count_indexed(r.until.get(), counter, *inner, outer);
+        break;
+      }
+      default: break;
+    }
+  }
+  return n;
+}
+
+std::optional<Compiler::RowAccess> Compiler::row_for(const Place& p) {
+  if (p.k != Place::K::FrameIdx || !p.proven || !p.two || p.sk != SK::Var || row_loops_.empty()) return std::nullopt;
+  const uint32_t size = p.type->size;
+  if (!p.type->is_elementary() || (size != 1 && size != 2 && size != 4 && size != 8)) return std::nullopt;
+  auto same = [](Slot x, Slot y) { return x.off == y.off && x.kind == y.kind; };
+  // The innermost loop keeping rows whose counter is one of the indices; the other index
+  // must be a counter of a loop around it (constant while it runs).
+  for (size_t li = row_loops_.size(); li-- > 0;) {
+    RowLoop& loop = row_loops_[li];
+    const bool first = same(p.idx, loop.counter), second = same(p.idx2, loop.counter);
+    if (!first && !second) continue;
+    if (first && second) return std::nullopt;
+    const Slot inner = first ? p.idx : p.idx2, outer = first ? p.idx2 : p.idx;
+    const int64_t m_inner = first ? p.stride : p.stride2, m_outer = first ? p.stride2 : p.stride;
+    if (inner.kind != SK::Var || outer.kind != SK::Var) return std::nullopt;
+    bool around = false;
+    for (size_t d = 0; d < loop.depth && d < counters_.size(); ++d) around = around || same(counters_[d].slot, outer);
+    if (!around) return std::nullopt;
+    const int64_t k = int64_t{p.off} + p.field - int64_t{p.lo} * p.stride - int64_t{p.lo2} * p.stride2;
+    auto fits = [](int64_t x) { return x >= INT32_MIN && x <= INT32_MAX; };
+    if (!fits(k) || !fits(m_inner) || !fits(m_outer)) return std::nullopt;
+    RowAccess a{Slot{}, inner, m_inner};
+    for (size_t c = 0; c < loop.used.size(); ++c) {
+      const RowOffset& u = loop.used[c];
+      if (u.k == k && same(u.v, outer) && u.m == m_outer) {
+        a.row = loop.slots[c];
+        return a;
+      }
+    }
+    if (loop.used.size() == loop.slots.size()) return std::nullopt;
+    loop.used.push_back({k, outer, m_outer});
+    a.row = loop.slots[loop.used.size() - 1];
+    return a;
+  }
+  return std::nullopt;
+}
+
 void Compiler::for_stmt(const ForStmt& s) {
   Place var = place(*s.var, true);
   if (!var.ok) return;
@@ -735,8 +889,6 @@ void Compiler::for_stmt(const ForStmt& s) {
     // Coverage records that the body ran, once per entry into the loop, not per iteration.
     uint32_t decision = kNoBranch;
     ArmScope in(b_, branch(s.loc, "FOR", s.loc, &decision, s.body));
-    bind(body);
-    write_out();
     b_->loops.push_back({exit, cont});
     // A DINT local counted in place, with bounds that are constants or counters proven
     // the same way, by a constant step, in a body that cannot change it: inside the body
@@ -758,12 +910,47 @@ void Compiler::for_stmt(const ForStmt& s) {
       // entry be gone (mutation analysis removes and negates conditional jumps): hence
       // FROM's whole range, not only TO's side of it.
       int64_t flo, fhi, tlo, thi;
-      if (bounds(from, &flo, &fhi) && bounds(to, &tlo, &thi) &&
-          keeps_counter(s.body, canon(static_cast<const NameExpr&>(*s.var).name.text)))
-        counters_.push_back({iv, down ? std::min(tlo, flo) : flo, down ? fhi : std::max(thi, fhi)});
+      const std::string name = canon(static_cast<const NameExpr&>(*s.var).name.text);
+      if (bounds(from, &flo, &fhi) && bounds(to, &tlo, &thi) && keeps_counter(s.body, name)) {
+        counters_.push_back({iv, down ? std::min(tlo, flo) : flo, down ? fhi : std::max(thi, fhi), name});
+        // Row offsets for the rank-2 accesses the body makes by the counter: their slots
+        // and the ROWS that sets them are laid down now, what each holds is known after
+        // the body.
+        std::vector<std::string> nested;
+        const size_t want = std::min<size_t>(row_candidates(s.body, name, &nested), 8);
+        if (want > 0 && iv.kind == SK::Var && opt_.row_offsets) {
+          RowLoop loop;
+          loop.counter = iv;
+          loop.depth = counters_.size() - 1;
+          std::vector<Arg> args{Arg(static_cast<uint32_t>(2 + 4 * want)), Arg(0u)};
+          for (size_t c = 0; c < want; ++c) {
+            loop.slots.push_back(temp(4, 4));
+            args.insert(args.end(), {Arg(loop.slots.back()), Arg(0u), Arg(0u), Arg(0u)});
+          }
+          loop.at = static_cast<uint32_t>(b_->code.size());
+          emit_list(Op::ROWS, args);
+          row_loops_.push_back(std::move(loop));
+        }
+      }
     }
+    // Jumps back to the body skip the ROWS just emitted (only a counter in place has
+    // rows; write_out stores any other before each pass).
+    bind(body);
+    write_out();
     stmts(s.body);
     counters_.resize(outer);
+    if (!row_loops_.empty() && row_loops_.back().depth == outer) {
+      const RowLoop& rows = row_loops_.back();
+      auto& code = b_->code;
+      code[rows.at + 2] = static_cast<uint32_t>(rows.used.size());
+      for (size_t c = 0; c < rows.used.size(); ++c) {
+        uint32_t* e = &code[rows.at + 3 + 4 * c];
+        e[1] = static_cast<uint32_t>(static_cast<int32_t>(rows.used[c].k));
+        e[2] = rows.used[c].v.off;
+        e[3] = static_cast<uint32_t>(static_cast<int32_t>(rows.used[c].m));
+      }
+      row_loops_.pop_back();
+    }
     b_->loops.pop_back();
     bind(cont);
     read_back();

@@ -369,6 +369,8 @@ class Translator {
       case Op::BAND: case Op::BOR: case Op::BXOR: case Op::BNOT: case Op::RISE: case Op::FALL:
       case Op::STEADY_HIGH: case Op::STEADY_LOW: case Op::TOBOOL8: case Op::TOBOOL16: case Op::TOBOOL32: case Op::TOBOOL64:
       case Op::DIVK_I16: case Op::DIVK_I32: case Op::MODK_I16: case Op::MODK_I32:
+      case Op::ROWS: case Op::LDXR1: case Op::LDXR2: case Op::LDXR4: case Op::LDXR8:
+      case Op::STXR1: case Op::STXR2: case Op::STXR4: case Op::STXR8:
         return true;
       default: break;
     }
@@ -764,6 +766,29 @@ class Translator {
         s += fmt::format("default: {} }}", go(w[4]));
         return true;
       }
+      case Op::ROWS:
+        s.clear();
+        for (uint32_t e = 0; e < w[2]; ++e) {
+          const int at = 3 + 4 * static_cast<int>(e);
+          s += "{ " + W("int32_t", at, fmt::format("(int32_t)((int64_t){} + (int64_t){} * {})", S(at + 1), R("int32_t", at + 2), S(at + 3))) +
+               " } ";
+        }
+        return true;
+      case Op::LDXR1: case Op::LDXR2: case Op::LDXR4: case Op::LDXR8: {
+        const char* t = op == Op::LDXR1 ? "uint8_t" : op == Op::LDXR2 ? "uint16_t" : op == Op::LDXR4 ? "uint32_t" : "uint64_t";
+        // The compiler proved the element inside the array; the C++ compiler is told so.
+        s = fmt::format("int64_t at = (int64_t){} + (int64_t){} * {}; if (at < {}ll || at > {}ll) __builtin_unreachable(); ",
+                        R("int32_t", 2), R("int32_t", 3), S(4), w[5], int64_t{w[5]} + w[6] - ctype_size(t));
+        s += W(t, 1, fmt::format("ld<{}>(base + at)", t));
+        return true;
+      }
+      case Op::STXR1: case Op::STXR2: case Op::STXR4: case Op::STXR8: {
+        const char* t = op == Op::STXR1 ? "uint8_t" : op == Op::STXR2 ? "uint16_t" : op == Op::STXR4 ? "uint32_t" : "uint64_t";
+        s = fmt::format("int64_t at = (int64_t){} + (int64_t){} * {}; if (at < {}ll || at > {}ll) __builtin_unreachable(); ",
+                        R("int32_t", 1), R("int32_t", 2), S(3), w[4], int64_t{w[4]} + w[5] - ctype_size(t));
+        s += fmt::format("st<{}>(base + at, {});", t, R(t, 6));
+        return true;
+      }
       case Op::COV: {
         uint32_t b = w[1] - branch_base_.at(start_);
         s = fmt::format("cov{} |= (uint64_t)1 << {};", b >> 6, b & 63);
@@ -1112,7 +1137,10 @@ class Translator {
       case Op::BAND: case Op::BOR: case Op::BXOR: case Op::BNOT: case Op::RISE: case Op::FALL:
       case Op::STEADY_HIGH: case Op::STEADY_LOW: case Op::TOBOOL8: case Op::TOBOOL16: case Op::TOBOOL32: case Op::TOBOOL64:
       case Op::DIVK_I16: case Op::DIVK_I32: case Op::MODK_I16: case Op::MODK_I32:
+      case Op::ROWS: case Op::LDXR1: case Op::LDXR2: case Op::LDXR4: case Op::LDXR8:
         return {};
+      // Elements through a row offset, inside the array the instruction names.
+      case Op::STXR1: case Op::STXR2: case Op::STXR4: case Op::STXR8: return range(w[4], w[5]);
       // Block writes into the frame.
       case Op::MOVN: case Op::LDGN: case Op::INITBLK: return range(w[1], w[3]);
       case Op::LDIN: return range(w[1], w[4]);
@@ -1282,7 +1310,9 @@ class Translator {
       case Op::BAND: case Op::BOR: case Op::BXOR: case Op::BNOT: case Op::RISE: case Op::FALL:
       case Op::STEADY_HIGH: case Op::STEADY_LOW: case Op::TOBOOL8: case Op::TOBOOL16: case Op::TOBOOL32: case Op::TOBOOL64:
       case Op::DIVK_I16: case Op::DIVK_I32: case Op::MODK_I16: case Op::MODK_I32: case Op::INITBLK: case Op::LDGN: case Op::LDIN:
+      case Op::ROWS: case Op::STXR1: case Op::STXR2: case Op::STXR4: case Op::STXR8:
         return {};
+      case Op::LDXR1: case Op::LDXR2: case Op::LDXR4: case Op::LDXR8: return range(w[5], w[6]);
       case Op::FBENTER: return range(2, 6);
       case Op::FNMOCK: return range(w[2], w[3]);
       case Op::MOVN: case Op::STGN: return range(w[2], w[3]);

@@ -72,6 +72,7 @@ bool is_conditional_jump(Op op) {
 uint32_t op_length(const uint32_t* code) {
   Op op = static_cast<Op>(code[0]);
   if (op == Op::JTAB) return 1 + 4 + code[3];
+  if (op == Op::ROWS) return 1 + code[1];
   return 1 + kOps[code[0]].nargs;
 }
 
@@ -852,6 +853,28 @@ L_STXB: {
   NEXT(8);
 }
 #undef ELEM_INDEX2
+  // Rank-2 elements in a FOR loop: the offset of the row (the part the loop does not
+  // change) from a slot ROWS set on the loop's entry, plus counter * stride. The compiler
+  // proved both indices inside their dimensions, as for LDXXN.
+#define ROW_IMPL(N, T)                                                                          \
+  L_LDXR##N:                                                                                    \
+    W(T, 1, ld<T>(base + (int64_t{R(int32_t, 2)} + int64_t{R(int32_t, 3)} * static_cast<int32_t>(pc[4])))); \
+    NEXT(6);                                                                                    \
+  L_STXR##N:                                                                                    \
+    st<T>(base + (int64_t{R(int32_t, 1)} + int64_t{R(int32_t, 2)} * static_cast<int32_t>(pc[3])), R(T, 6)); \
+    NEXT(6);
+  ROW_IMPL(1, uint8_t)
+  ROW_IMPL(2, uint16_t)
+  ROW_IMPL(4, uint32_t)
+  ROW_IMPL(8, uint64_t)
+#undef ROW_IMPL
+L_ROWS: {
+  for (uint32_t e = 0, n = pc[2]; e < n; ++e)
+    W(int32_t, 3 + 4 * e,
+      static_cast<int32_t>(int64_t{static_cast<int32_t>(pc[4 + 4 * e])} + int64_t{R(int32_t, 5 + 4 * e)} * static_cast<int32_t>(pc[6 + 4 * e])));
+  pc += 1 + pc[1];
+  DISPATCH();
+}
 
 L_MADD_I32: W(int32_t, 1, wadd<int32_t>(wmul<int32_t>(R(int32_t, 2), R(int32_t, 3)), R(int32_t, 4))); NEXT(4);
 
