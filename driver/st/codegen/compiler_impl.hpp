@@ -39,6 +39,7 @@ struct Slot {
   uint32_t off = 0;
   SK kind = SK::Var;
   Slot plus(uint32_t d) const { return Slot{off + d, kind}; }
+  bool operator==(const Slot&) const = default;
 };
 
 // Which code of a POU a call goes to: its body, or (FB/PROGRAM) the entry that runs
@@ -127,6 +128,9 @@ struct Place {
   // (LDXXN/STXXN: no check at run time).
   bool proven = false;
   uint32_t arr_bytes = 0;  // FrameIdx: the whole array's size, from off
+  // FrameIdx with two indices: the element's offset from off when both index variables
+  // are 0 (the lower bounds folded in), as LDXXN/STXXN and the row offsets use it.
+  int64_t unchecked_disp() const { return int64_t{field} - int64_t{lo} * stride - int64_t{lo2} * stride2; }
   uint8_t bit = 0;    // AbsBit, Bit
   std::shared_ptr<Place> inner;  // Bit: the word
   bool readonly = false;
@@ -435,7 +439,14 @@ class Compiler {
     std::vector<RowOffset> used;
   };
   std::vector<RowLoop> row_loops_;
-  size_t row_candidates(const StmtList& body, const std::string& counter, std::vector<std::string>* inner) const;
+  // What row_candidates looks for: accesses by `counter` and one of `outer` (the counters
+  // of the proven loops around it), none by `inner` (counters of loops nested in it, whose
+  // accesses those loops keep rows for).
+  struct RowScan {
+    std::string counter;
+    std::vector<std::string> outer, inner;
+  };
+  static size_t row_candidates(const StmtList& body, RowScan& scan);
   struct RowAccess {
     Slot row, counter;
     int64_t m = 0;

@@ -389,9 +389,7 @@ Place Compiler::member_place(Place base, const Ident& member, SourceLoc loc) {
 namespace {
 // LDXXN/STXXN: the lower bounds folded into the element's offset (a 32-bit two's-complement
 // displacement), so the instruction only multiplies and adds.
-uint32_t unchecked_field(const Place& p) {
-  return static_cast<uint32_t>(static_cast<int64_t>(p.field) - int64_t{p.lo} * p.stride - int64_t{p.lo2} * p.stride2);
-}
+uint32_t unchecked_field(const Place& p) { return static_cast<uint32_t>(p.unchecked_disp()); }
 // Data alone: nothing in it can be called or reached through (no FB instance, reference,
 // pointer or interface), so an access to it is done where it is compiled.
 bool plain_data(const Type* t) {

@@ -699,12 +699,10 @@ const NameExpr* index_variable(const Expr& e) {
   return nullptr;
 }
 
-// `inner`: counters of FOR loops nested inside the counter's; an access by one of them is
-// theirs to keep a row for.
-// `outer`: the counters of the proven loops around the counter's, the only other index a
-// row can be kept for.
-size_t count_indexed(const Expr* e, const std::string& counter, const std::vector<std::string>& inner,
-                     const std::vector<std::string>& outer) {
+size_t count_indexed(const Expr* e, const Compiler::RowScan& scan) {
+  auto among = [](const std::vector<std::string>& names, const std::string& n) {
+    return std::find(names.begin(), names.end(), n) != names.end();
+  };
   size_t n = 0;
   while (e) {
     switch (e->kind) {
@@ -713,14 +711,16 @@ size_t count_indexed(const Expr* e, const std::string& counter, const std::vecto
         bool by_counter = false, by_outer = false, simple = true;
         size_t vars = 0;
         for (const auto& i : x.indices) {
-          const NameExpr* v = index_variable(*i);
-          if (v) ++vars;
-          else if (i->kind != ExprKind::Literal) simple = false;
-          const std::string name = v ? canon(v->name.text) : std::string();
-          if (v && name == counter) by_counter = true;
-          if (v && std::find(outer.begin(), outer.end(), name) != outer.end()) by_outer = true;
-          if (v && std::find(inner.begin(), inner.end(), name) != inner.end()) simple = false;
-          n += count_indexed(i.get(), counter, inner, outer);
+          if (const NameExpr* v = index_variable(*i)) {
+            const std::string name = canon(v->name.text);
+            ++vars;
+            by_counter = by_counter || name == scan.counter;
+            by_outer = by_outer || among(scan.outer, name);
+            simple = simple && !among(scan.inner, name);
+          } else if (i->kind != ExprKind::Literal) {
+            simple = false;
+          }
+          n += count_indexed(i.get(), scan);
         }
         if (by_counter && by_outer && simple && vars == 2) ++n;
         e = x.base.get();
@@ -733,12 +733,12 @@ size_t count_indexed(const Expr* e, const std::string& counter, const std::vecto
       case ExprKind::Binary: {
         // A long chain is a deep left spine: walked in this loop, the right operands recursively.
         const auto& b = static_cast<const BinaryExpr&>(*e);
-        n += count_indexed(b.rhs.get(), counter, inner, outer);
+        n += count_indexed(b.rhs.get(), scan);
         e = b.lhs.get();
         break;
       }
       case ExprKind::Call: {
-        for (const auto& a : static_cast<const CallExpr&>(*e).args) n += count_indexed(a.value.get(), counter, inner, outer);
+        for (const auto& a : static_cast<const CallExpr&>(*e).args) n += count_indexed(a.value.get(), scan);
         e = nullptr;
         break;
       }
@@ -749,52 +749,49 @@ size_t count_indexed(const Expr* e, const std::string& counter, const std::vecto
 }
 }  // namespace
 
-// How many row offsets a FOR loop over `counter` may keep: the accesses in its body with
-// two variable indices (each plus or minus a literal, the others literals), one of them
-// the counter. An upper bound: the compiler decides access by access (row_for).
-size_t Compiler::row_candidates(const StmtList& body, const std::string& counter, std::vector<std::string>* inner) const {
-  std::vector<std::string> outer;
-  for (const CounterRange& c : counters_)
-    if (c.name != counter) outer.push_back(c.name);
+// How many row offsets a FOR loop may keep: the accesses in its body with two variable
+// indices (each plus or minus a literal, the others literals), its counter and a counter
+// of a proven loop around it. An upper bound: the compiler decides access by access
+// (row_for).
+size_t Compiler::row_candidates(const StmtList& body, RowScan& scan) {
   size_t n = 0;
   for (const StmtPtr& sp : body) {
     const Stmt& st = *sp;
     switch (st.kind) {
       case StmtKind::Assign: {
         const auto& a = static_cast<const AssignStmt&>(st);
-        n += count_indexed(a.lhs.get(), counter, *inner, outer) + count_indexed(a.rhs.get(), counter, *inner, outer);
+        n += count_indexed(a.lhs.get(), scan) + count_indexed(a.rhs.get(), scan);
         break;
       }
       case StmtKind::If: {
         const auto& i = static_cast<const IfStmt&>(st);
-        for (const auto& arm : i.arms) n += count_indexed(arm.cond.get(), counter, *inner, outer) + row_candidates(arm.body, counter, inner);
-        if (i.else_body) n += row_candidates(*i.else_body, counter, inner);
+        for (const auto& arm : i.arms) n += count_indexed(arm.cond.get(), scan) + row_candidates(arm.body, scan);
+        if (i.else_body) n += row_candidates(*i.else_body, scan);
         break;
       }
       case StmtKind::Case: {
         const auto& c = static_cast<const CaseStmt&>(st);
-        n += count_indexed(c.selector.get(), counter, *inner, outer);
-        for (const auto& arm : c.arms) n += row_candidates(arm.body, counter, inner);
-        if (c.else_body) n += row_candidates(*c.else_body, counter, inner);
+        n += count_indexed(c.selector.get(), scan);
+        for (const auto& arm : c.arms) n += row_candidates(arm.body, scan);
+        if (c.else_body) n += row_candidates(*c.else_body, scan);
         break;
       }
       case StmtKind::For: {
         const auto& f = static_cast<const ForStmt&>(st);
-        n += count_indexed(f.from.get(), counter, *inner, outer) + count_indexed(f.to.get(), counter, *inner, outer) +
-             count_indexed(f.by.get(), counter, *inner, outer);
-        inner->push_back(f.var->kind == ExprKind::Name ? canon(static_cast<const NameExpr&>(*f.var).name.text) : std::string());
-        n += row_candidates(f.body, counter, inner);
-        inner->pop_back();
+        n += count_indexed(f.from.get(), scan) + count_indexed(f.to.get(), scan) + count_indexed(f.by.get(), scan);
+        scan.inner.push_back(f.var->kind == ExprKind::Name ? canon(static_cast<const NameExpr&>(*f.var).name.text) : std::string());
+        n += row_candidates(f.body, scan);
+        scan.inner.pop_back();
         break;
       }
       case StmtKind::While: {
         const auto& w = static_cast<const WhileStmt&>(st);
-        n += count_indexed(w.cond.get(), counter, *inner, outer) + row_candidates(w.body, counter, inner);
+        n += count_indexed(w.cond.get(), scan) + row_candidates(w.body, scan);
         break;
       }
       case StmtKind::Repeat: {
         const auto& r = static_cast<const RepeatStmt&>(st);
-        n += row_candidates(r.body, counter, inner) + count_indexed(r.until.get(), counter, *inner, outer);
+        n += row_candidates(r.body, scan) + count_indexed(r.until.get(), scan);
         break;
       }
       default: break;
@@ -807,27 +804,26 @@ std::optional<Compiler::RowAccess> Compiler::row_for(const Place& p) {
   if (p.k != Place::K::FrameIdx || !p.proven || !p.two || p.sk != SK::Var || row_loops_.empty()) return std::nullopt;
   const uint32_t size = p.type->size;
   if (!p.type->is_elementary() || (size != 1 && size != 2 && size != 4 && size != 8)) return std::nullopt;
-  auto same = [](Slot x, Slot y) { return x.off == y.off && x.kind == y.kind; };
   // The innermost loop keeping rows whose counter is one of the indices; the other index
   // must be a counter of a loop around it (constant while it runs).
   for (size_t li = row_loops_.size(); li-- > 0;) {
     RowLoop& loop = row_loops_[li];
-    const bool first = same(p.idx, loop.counter), second = same(p.idx2, loop.counter);
+    const bool first = p.idx == loop.counter, second = p.idx2 == loop.counter;
     if (!first && !second) continue;
     if (first && second) return std::nullopt;
     const Slot inner = first ? p.idx : p.idx2, outer = first ? p.idx2 : p.idx;
     const int64_t m_inner = first ? p.stride : p.stride2, m_outer = first ? p.stride2 : p.stride;
     if (inner.kind != SK::Var || outer.kind != SK::Var) return std::nullopt;
     bool around = false;
-    for (size_t d = 0; d < loop.depth && d < counters_.size(); ++d) around = around || same(counters_[d].slot, outer);
+    for (size_t d = 0; d < loop.depth && d < counters_.size(); ++d) around = around || counters_[d].slot == outer;
     if (!around) return std::nullopt;
-    const int64_t k = int64_t{p.off} + p.field - int64_t{p.lo} * p.stride - int64_t{p.lo2} * p.stride2;
+    const int64_t k = int64_t{p.off} + p.unchecked_disp();
     auto fits = [](int64_t x) { return x >= INT32_MIN && x <= INT32_MAX; };
     if (!fits(k) || !fits(m_inner) || !fits(m_outer)) return std::nullopt;
     RowAccess a{Slot{}, inner, m_inner};
     for (size_t c = 0; c < loop.used.size(); ++c) {
       const RowOffset& u = loop.used[c];
-      if (u.k == k && same(u.v, outer) && u.m == m_outer) {
+      if (u.k == k && u.v == outer && u.m == m_outer) {
         a.row = loop.slots[c];
         return a;
       }
@@ -916,8 +912,9 @@ void Compiler::for_stmt(const ForStmt& s) {
         // Row offsets for the rank-2 accesses the body makes by the counter: their slots
         // and the ROWS that sets them are laid down now, what each holds is known after
         // the body.
-        std::vector<std::string> nested;
-        const size_t want = std::min<size_t>(row_candidates(s.body, name, &nested), 8);
+        RowScan scan{name, {}, {}};
+        for (size_t d = 0; d + 1 < counters_.size(); ++d) scan.outer.push_back(counters_[d].name);
+        const size_t want = std::min<size_t>(row_candidates(s.body, scan), 8);
         if (want > 0 && iv.kind == SK::Var && opt_.row_offsets) {
           RowLoop loop;
           loop.counter = iv;
