@@ -311,6 +311,7 @@ int cmd_run(const std::vector<std::string>& args) {
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
   opt.warnings = false;
+  opt.coverage = vm.count("coverage") > 0;  // else the arms spend nothing on marking it
   auto b = load(strings_of(vm, "files"), opt, "run");
   if (!b || !b->ok()) return 2;
   const st::Application& app = *b->app;

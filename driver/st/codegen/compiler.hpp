@@ -29,6 +29,10 @@ struct CompileOptions {
   // FOR loops set the row offsets of rank-2 accesses once per entry (ROWS, LDXR/STXR);
   // off, each access computes its whole offset (tests compare the two).
   bool row_offsets = true;
+  // Every branch arm marks its bit of the branch coverage as it is entered (COV). Off, the
+  // arms are still numbered (Application::branches) but mark nothing: for runs that report
+  // no coverage (`plcfi run` without --coverage), which then spend nothing on it.
+  bool coverage = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

@@ -21,7 +21,7 @@ uint32_t Compiler::branch(SourceLoc loc, const char* kind, SourceLoc stmt, uint3
   if (!body.empty()) bp.body = body.front()->loc;
   bp.parent = b_ ? b_->arm : kNoBranch;
   app_->branches.push_back(std::move(bp));
-  emit(Op::COV, {id});
+  if (opt_.coverage) emit(Op::COV, {id});
   return id;
 }
 

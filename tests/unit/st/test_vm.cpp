@@ -606,6 +606,28 @@ TEST(VmCoverage, CoveredAccumulatesAcrossScansAndReportsMisses) {
   EXPECT_EQ(std::string::npos, rep.find("vm.st:3:")) << rep;
 }
 
+// Compiled without coverage (`plcfi run` without --coverage), the arms are still numbered
+// but no COV is laid down: the program computes the same values and marks no arm.
+TEST(VmCoverage, WithoutCoverageTheArmsMarkNothingAndComputeTheSame) {
+  CompileOptions off;
+  off.coverage = false;
+  VmRun with(kBranches), without(kBranches, off);
+  ASSERT_TRUE(with.ok());
+  ASSERT_TRUE(without.ok());
+  EXPECT_EQ(with.b->app->branches.size(), without.b->app->branches.size());
+  EXPECT_NE(std::string::npos, with.disasm().find("COV ")) << with.disasm();
+  EXPECT_EQ(std::string::npos, without.disasm().find("COV ")) << without.disasm();
+  for (int x : {1, 0, 7, -3}) {
+    with.set("Main.x", x);
+    without.set("Main.x", x);
+    ASSERT_TRUE(with.scan());
+    ASSERT_TRUE(without.scan());
+    EXPECT_EQ(with.get("Main.y"), without.get("Main.y")) << "x = " << x;
+  }
+  EXPECT_GT(with.taken_count(), 0u);
+  EXPECT_EQ(0u, without.taken_count());
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ numerics as IEC and MATIEC
