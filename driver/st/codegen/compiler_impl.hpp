@@ -387,6 +387,7 @@ class Compiler {
   std::optional<Val> bit_of_shift(bool whole_condition);
   void note_shift(const Place& p);
   std::optional<Val> multiply_add(Slot a, Slot b, const Type* t);
+  std::optional<Val> shifted_operand(Op bitop, Slot a, Slot b, const Type* t);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);
   Val load_once(const Place& p);

@@ -1002,6 +1002,7 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   if (is_logic(e.op)) {
     if (t->is_real()) return op_error();
     Op bitop = e.op == BinaryOp::And ? Op::AND_I8 : e.op == BinaryOp::Or ? Op::OR_I8 : Op::XOR_I8;
+    if (auto v = shifted_operand(bitop, a, b, t)) return in_register(*v);
     Slot d = temp_for(t);
     emit(int_op(bitop, t->storage()), {d, a, b});
     def(d);
@@ -1129,6 +1130,40 @@ std::optional<Val> Compiler::multiply_add(Slot a, Slot b, const Type* t) {
   auto [x, y] = unemit(at);
   Slot d = temp_for(t);
   emit(Op::MADD_I32, {d, x, y, z});
+  def(d);
+  Val v;
+  v.type = t;
+  v.slot = d;
+  return v;
+}
+
+// A bitwise AND, OR or XOR one of whose operands is the shift just computed ("SHL_T s, x,
+// n" or SHR_T the last instruction, in the same line and block, defining the temporary s,
+// with a constant count 0 < n < width and T the operation's own type): one instruction
+// computes "other OP (x << n)" (ANDSHL_T, ..., XORSHR_T, the count an immediate), as a
+// barrel shifter does. CRCs, LFSRs, parities and bit packing are made of these. Nothing
+// changed when it does not apply (a count from a variable, 0 or the width or more).
+std::optional<Val> Compiler::shifted_operand(Op bitop, Slot a, Slot b, const Type* t) {
+  auto& code = b_->code;
+  const uint32_t at = b_->last_instr;
+  if (at >= code.size() || b_->last_def_pos != at || b_->last_label_pos > at) return std::nullopt;
+  if (!b_->lines.empty() && b_->lines.back().first > at) return std::nullopt;
+  const Storage st = t->storage();
+  if (!(t->is_integer() || t->is_bitstring()) || t->kind == TypeKind::Bool || storage_index(st) >= 8) return std::nullopt;
+  const bool shl = code[at] == static_cast<uint32_t>(int_op(Op::SHL_I8, st));
+  if (!shl && code[at] != static_cast<uint32_t>(int_op(Op::SHR_I8, st))) return std::nullopt;
+  const Slot s = b_->last_def;
+  auto is_s = [&](Slot x) { return x.kind == SK::Temp && s.kind == SK::Temp && x.off == s.off; };
+  if (is_s(a) == is_s(b)) return std::nullopt;
+  const std::optional<uint64_t> n = const_at(at + 3, 8);  // the count, a ULINT
+  static constexpr uint64_t kBits[] = {8, 16, 32, 64, 8, 16, 32, 64};
+  if (!n || *n == 0 || *n >= kBits[storage_index(st)]) return std::nullopt;
+  const Slot other = is_s(a) ? b : a;
+  const Arg x = unemit(at).first;
+  static constexpr Op kFused[3][2] = {{Op::ANDSHR_I8, Op::ANDSHL_I8}, {Op::ORSHR_I8, Op::ORSHL_I8}, {Op::XORSHR_I8, Op::XORSHL_I8}};
+  const int row = bitop == Op::AND_I8 ? 0 : bitop == Op::OR_I8 ? 1 : 2;
+  Slot d = temp_for(t);
+  emit(int_op(kFused[row][shl ? 1 : 0], st), {d, other, x, static_cast<uint32_t>(*n)});
   def(d);
   Val v;
   v.type = t;

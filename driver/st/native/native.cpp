@@ -405,6 +405,8 @@ class Translator {
         {"JTZ", TypedFamily::kNever},    {"JTNZ", TypedFamily::kNever},   {"SHLD", TypedFamily::kNever},
         {"SHRD", TypedFamily::kNever},   {"ROLD", TypedFamily::kNever},   {"RORD", TypedFamily::kNever},
         {"GETBITD", TypedFamily::kNever},
+        {"ANDSHL", TypedFamily::kNever}, {"ANDSHR", TypedFamily::kNever}, {"ORSHL", TypedFamily::kNever},
+        {"ORSHR", TypedFamily::kNever},  {"XORSHL", TypedFamily::kNever}, {"XORSHR", TypedFamily::kNever},
     };
     size_t us = op_name.find('_');
     if (us == std::string_view::npos) return nullptr;
@@ -1064,6 +1066,11 @@ class Translator {
       s = W(C, 1, fmt::format("({}<{}>({}, dint_count({})))", f, C, R(C, 2), R("int32_t", 3)));
     } else if (fam == "GETBITD") {
       s = W("uint8_t", 1, fmt::format("((uint8_t)((shr<{}>({}, dint_count({})) & 1u) ^ {}))", C, R(C, 2), R("int32_t", 3), K(4)));
+    } else if (fam == "ANDSHL" || fam == "ANDSHR" || fam == "ORSHL" || fam == "ORSHR" || fam == "XORSHL" || fam == "XORSHR") {
+      // A bitwise operation on a shifted operand: the count is an immediate below the width.
+      const bool shl = fam.substr(fam.size() - 3) == "SHL";
+      const char* bit = fam[0] == 'A' ? "&" : fam[0] == 'O' ? "|" : "^";
+      s = W(C, 1, fmt::format("({0})({1} {2} {3}<{0}>({4}, {5}))", C, R(C, 2), bit, shl ? "shl" : "shr", R(C, 3), K(4)));
     } else if (fam == "CHK")
       s = fmt::format("{0} v = {1}, lo = {2}, hi = {3}; if (v < lo || v > hi) TRAP({4}, {5}, v, lo, hi);", C, R(C, 1),
                       R(C, 2), R(C, 3), w[4] == 1 ? 2 : 3, P(pc));

@@ -710,6 +710,12 @@ L_TOBOOL64: W(uint8_t, 1, R(uint64_t, 2) != 0); NEXT(2);
   L_GETBITD_##TN:                                                                        \
     W(uint8_t, 1, static_cast<uint8_t>((shr<C>(R(C, 2), dint_count(R(int32_t, 3))) & 1u) ^ pc[4])); \
     NEXT(4);                                                                             \
+  L_ANDSHL_##TN: W(C, 1, static_cast<C>(R(C, 2) & shl<C>(R(C, 3), pc[4]))); NEXT(4);          \
+  L_ANDSHR_##TN: W(C, 1, static_cast<C>(R(C, 2) & shr<C>(R(C, 3), pc[4]))); NEXT(4);          \
+  L_ORSHL_##TN: W(C, 1, static_cast<C>(R(C, 2) | shl<C>(R(C, 3), pc[4]))); NEXT(4);           \
+  L_ORSHR_##TN: W(C, 1, static_cast<C>(R(C, 2) | shr<C>(R(C, 3), pc[4]))); NEXT(4);           \
+  L_XORSHL_##TN: W(C, 1, static_cast<C>(R(C, 2) ^ shl<C>(R(C, 3), pc[4]))); NEXT(4);          \
+  L_XORSHR_##TN: W(C, 1, static_cast<C>(R(C, 2) ^ shr<C>(R(C, 3), pc[4]))); NEXT(4);          \
   L_CHK_##TN: {                                                                          \
     C v = R(C, 1), lo = R(C, 2), hi = R(C, 3);                                           \
     if ((v < lo || v > hi) && pc[4] == 1)                                                \
