@@ -163,6 +163,9 @@ struct Body {
   uint32_t last_def_operand = 1;
   Slot last_def;
   uint32_t last_label_pos = 0;
+  // The last store into an element of a frame array of scalars (STX..., see
+  // stored_element): a load of the same element right after it reads the stored value.
+  uint32_t last_elem_store = UINT32_MAX;
   uint32_t last_instr = UINT32_MAX;
   uint32_t prev_instr = UINT32_MAX;  // the instruction before last_instr, while both stand
   uint32_t prev2_instr = UINT32_MAX;  // the instruction before prev_instr, while all three stand
@@ -390,6 +393,7 @@ class Compiler {
   std::optional<Val> shifted_operand(Op bitop, Slot a, Slot b, const Type* t);
   Place deref_place(Val ptr, const Type* target, SourceLoc loc);
   Val load(const Place& p);
+  std::optional<Slot> stored_element(Op load_op, const std::vector<Arg>& addr, const Place& p);
   Val load_once(const Place& p);
   Slot frame_idx(const Place& p);  // FrameIdx: the DINT index slot (made here when deferred)
   const Expr* cond_top_ = nullptr;  // the condition cond() is compiling

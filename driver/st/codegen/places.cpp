@@ -825,6 +825,43 @@ Val Compiler::load_once(const Place& p) {
   return v;
 }
 
+// A load of the element the instruction just before stored: "STX... a, i, ..., src"
+// then "LDX... t, a, i, ..." with the same operands (array, indices, bounds, field), no
+// jump target between them and no instruction (the loads of x[i] := v; IF x[i] ...). The
+// element holds src's value, so the load is not emitted and its value is read from src,
+// when src is a constant or a temporary nothing allocated since (which no call can
+// change: it stays reserved until the statement ends). The store checked the same indices
+// (nothing changed them: no index variable lies inside the array), so the load could not
+// trap. Null: emit the load.
+std::optional<Slot> Compiler::stored_element(Op load_op, const std::vector<Arg>& addr, const Place& p) {
+  auto& code = b_->code;
+  const uint32_t at = b_->last_elem_store;
+  const std::string_view ld = op_info(load_op).name;
+  if (at >= code.size() || b_->last_label_pos > at || p.arr_bytes == 0 || ld.substr(0, 2) != "LD") return std::nullopt;
+  const std::string_view st = op_info(static_cast<Op>(code[at])).name;
+  const uint32_t n = op_info(static_cast<Op>(code[at])).nargs;
+  if (st.substr(0, 2) != "ST" || st.substr(2) != ld.substr(2) || n != addr.size() + 1 || at + 1 + n != code.size())
+    return std::nullopt;
+  const uint32_t base_at = ld.rfind("LDXR", 0) == 0 ? 3 : 0;  // the array's operand (LDXR: row, counter, m first)
+  for (uint32_t i = 0; i < addr.size(); ++i) {
+    const Arg& a = addr[i];
+    const uint32_t word = at + 1 + i;
+    if (a.k == Arg::K::Slot) {
+      if (code[word] != a.v || kind_at(word) != a.sk) return std::nullopt;
+      // An index variable the store may have written (a UNION): its value may differ now.
+      if (i != base_at && a.sk == p.sk && uint64_t{a.v} < uint64_t{p.off} + p.arr_bytes && uint64_t{a.v} + 8 > p.off) return std::nullopt;
+    } else if (a.k != Arg::K::Imm || code[word] != a.v || kind_at(word) != SK::Var) {
+      return std::nullopt;
+    }
+  }
+  const Slot src{code[at + n], kind_at(at + n)};
+  if (src.kind == SK::Const) return src;
+  if (src.kind != SK::Temp || src.off < b_->temp_top) return std::nullopt;
+  b_->temp_top = src.off + std::max<uint32_t>(p.type->size, 1);
+  b_->temp_max = std::max(b_->temp_max, b_->temp_top);
+  return src;
+}
+
 Slot Compiler::frame_idx(const Place& p) {
   if (p.has_lin) {
     Slot sum = temp(4, 4);
@@ -926,39 +963,53 @@ Val Compiler::load(const Place& p) {
     }
     case Place::K::FrameIdx: {
       if (auto r = row_for(p)) {
-        Slot t = temp_for(p.type);
         Op op = size == 1 ? Op::LDXR1 : size == 2 ? Op::LDXR2 : size == 4 ? Op::LDXR4 : Op::LDXR8;
-        emit(op, {t, r->row, r->counter, static_cast<uint32_t>(static_cast<int32_t>(r->m)), Slot{p.off, p.sk}, p.arr_bytes});
+        std::vector<Arg> addr{r->row, r->counter, static_cast<uint32_t>(static_cast<int32_t>(r->m)), Slot{p.off, p.sk}, p.arr_bytes};
+        if (auto stored = stored_element(op, addr, p)) {
+          v.slot = *stored;
+          return v;
+        }
+        Slot t = temp_for(p.type);
+        addr.insert(addr.begin(), Arg(t));
+        emit_list(op, addr);
         def(t);
         v.slot = t;
         return v;
       }
       Slot idx = p.has_lin ? Slot{} : frame_idx(p);
-      Slot t = temp_for(p.type);
+      Op op;
+      std::vector<Arg> addr;  // the operands after the destination
       if (p.two && p.proven) {
-        Op op = size == 1 ? Op::LDXXN1 : size == 2 ? Op::LDXXN2 : size == 4 ? Op::LDXXN4 : Op::LDXXN8;
-        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
-                  p.count2, p.stride2, unchecked_field(p)});
+        op = size == 1 ? Op::LDXXN1 : size == 2 ? Op::LDXXN2 : size == 4 ? Op::LDXXN4 : Op::LDXXN8;
+        addr = {Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
+                p.count2, p.stride2, unchecked_field(p)};
       } else if (p.two) {
-        Op op = size == 1 ? Op::LDXX1 : size == 2 ? Op::LDXX2 : size == 4 ? Op::LDXX4 : Op::LDXX8;
-        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
-                  p.count2, p.stride2, p.field});
+        op = size == 1 ? Op::LDXX1 : size == 2 ? Op::LDXX2 : size == 4 ? Op::LDXX4 : Op::LDXX8;
+        addr = {Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
+                p.count2, p.stride2, p.field};
       } else if (p.has_lin) {
-        Op op = size == 1 ? Op::LDXL1 : size == 2 ? Op::LDXL2 : size == 4 ? Op::LDXL4 : Op::LDXL8;
-        emit(op, {t, Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count});
+        op = size == 1 ? Op::LDXL1 : size == 2 ? Op::LDXL2 : size == 4 ? Op::LDXL4 : Op::LDXL8;
+        addr = {Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count};
       } else if (p.stride && p.proven) {
-        Op op = size == 1 ? Op::LDXSN1 : size == 2 ? Op::LDXSN2 : size == 4 ? Op::LDXSN4 : Op::LDXSN8;
-        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+        op = size == 1 ? Op::LDXSN1 : size == 2 ? Op::LDXSN2 : size == 4 ? Op::LDXSN4 : Op::LDXSN8;
+        addr = {Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field};
       } else if (p.stride) {
-        Op op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
-        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field});
+        op = size == 1 ? Op::LDXS1 : size == 2 ? Op::LDXS2 : size == 4 ? Op::LDXS4 : Op::LDXS8;
+        addr = {Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field};
       } else if (p.proven) {
-        Op op = size == 1 ? Op::LDXN1 : size == 2 ? Op::LDXN2 : size == 4 ? Op::LDXN4 : Op::LDXN8;
-        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count});
+        op = size == 1 ? Op::LDXN1 : size == 2 ? Op::LDXN2 : size == 4 ? Op::LDXN4 : Op::LDXN8;
+        addr = {Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count};
       } else {
-        Op op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
-        emit(op, {t, Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count});
+        op = size == 1 ? Op::LDX1 : size == 2 ? Op::LDX2 : size == 4 ? Op::LDX4 : Op::LDX8;
+        addr = {Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count};
       }
+      if (auto stored = stored_element(op, addr, p)) {
+        v.slot = *stored;
+        return v;
+      }
+      Slot t = temp_for(p.type);
+      addr.insert(addr.begin(), Arg(t));
+      emit_list(op, addr);
       note_shift(p);
       def(t);
       v.slot = t;
@@ -1034,50 +1085,59 @@ void Compiler::store(const Place& p, Slot src) {
       if (auto r = row_for(p)) {
         Op op = size == 1 ? Op::STXR1 : size == 2 ? Op::STXR2 : size == 4 ? Op::STXR4 : Op::STXR8;
         emit(op, {r->row, r->counter, static_cast<uint32_t>(static_cast<int32_t>(r->m)), Slot{p.off, p.sk}, p.arr_bytes, src});
+        b_->last_elem_store = b_->last_instr;
         return;
       }
       if (p.two && p.proven) {
         Op op = size == 1 ? Op::STXXN1 : size == 2 ? Op::STXXN2 : size == 4 ? Op::STXXN4 : Op::STXXN8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
                   p.stride2, unchecked_field(p), src});
+        b_->last_elem_store = b_->last_instr;
         return;
       }
       if (p.two) {
         Op op = size == 1 ? Op::STXX1 : size == 2 ? Op::STXX2 : size == 4 ? Op::STXX4 : Op::STXX8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2), p.count2,
                   p.stride2, p.field, src});
+        b_->last_elem_store = b_->last_instr;
         return;
       }
       if (p.has_lin) {
         Op op = size == 1 ? Op::STXL1 : size == 2 ? Op::STXL2 : size == 4 ? Op::STXL4 : Op::STXL8;
         emit(op, {Slot{p.off, p.sk}, p.lin_x, p.lin_m, p.lin_y, static_cast<uint32_t>(p.lo), p.count, src});
+        b_->last_elem_store = b_->last_instr;
         return;
       }
       if (p.has_idx16 && p.stride) {
         Op op = size == 1 ? Op::STXSH1 : size == 2 ? Op::STXSH2 : size == 4 ? Op::STXSH4 : Op::STXSH8;
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        b_->last_elem_store = b_->last_instr;
         return;
       }
       if (p.has_idx16) {
         Op op = size == 1 ? Op::STXH1 : size == 2 ? Op::STXH2 : size == 4 ? Op::STXH4 : Op::STXH8;
         emit(op, {Slot{p.off, p.sk}, p.idx16, static_cast<uint32_t>(p.lo), p.count, src});
+        b_->last_elem_store = b_->last_instr;
         return;
       }
       if (p.stride && p.proven) {
         Op op = size == 1 ? Op::STXSN1 : size == 2 ? Op::STXSN2 : size == 4 ? Op::STXSN4 : Op::STXSN8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        b_->last_elem_store = b_->last_instr;
         note_shift(p);
         return;
       }
       if (p.stride) {
         Op op = size == 1 ? Op::STXS1 : size == 2 ? Op::STXS2 : size == 4 ? Op::STXS4 : Op::STXS8;
         emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.field, src});
+        b_->last_elem_store = b_->last_instr;
         note_shift(p);
         return;
       }
       Op op = p.proven ? (size == 1 ? Op::STXN1 : size == 2 ? Op::STXN2 : size == 4 ? Op::STXN4 : Op::STXN8)
                        : (size == 1 ? Op::STX1 : size == 2 ? Op::STX2 : size == 4 ? Op::STX4 : Op::STX8);
       emit(op, {Slot{p.off, p.sk}, p.idx, static_cast<uint32_t>(p.lo), p.count, src});
+      b_->last_elem_store = b_->last_instr;
       note_shift(p);
       return;
     }
