@@ -33,6 +33,10 @@ struct CompileOptions {
   // arms are still numbered (Application::branches) but mark nothing: for runs that report
   // no coverage (`plcfi run` without --coverage), which then spend nothing on it.
   bool coverage = true;
+  // An IF or CASE that ends a loop body ends its arms with a copy of the loop's bottom
+  // (LOOPUP, the WHILE or UNTIL test) instead of a jump to it (see loop_tail_); off, with
+  // the jump (tests compare the two).
+  bool loop_tails = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

@@ -444,6 +444,12 @@ class Compiler {
     std::vector<RowOffset> used;
   };
   std::vector<RowLoop> row_loops_;
+  // Set while the statement being compiled is the last of a loop body, or the last of an
+  // arm of an IF or CASE that is: where an arm would jump to the statement's end (the
+  // loop's bottom), this emits the bottom itself instead (the back edge, then a jump to
+  // the loop's exit), which spares the jump on every pass through the arm. Null elsewhere.
+  const std::function<void()>* loop_tail_ = nullptr;
+  void arm_end(Label end);
   // What row_candidates looks for: accesses by `counter` and one of `outer` (the counters
   // of the proven loops around it), none by `inner` (counters of loops nested in it, whose
   // accesses those loops keep rows for).

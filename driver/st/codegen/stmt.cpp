@@ -172,7 +172,10 @@ void Compiler::stmts(const StmtList& list) {
   DepthScope depth(b_->stmt_depth);
   if (b_->stmt_depth == 1) declare_labels(list);
   bool dead = false;
+  // Only the last statement of the list ends where the list does (see loop_tail_).
+  const std::function<void()>* const tail = loop_tail_;
   for (const auto& s : list) {
+    loop_tail_ = &s == &list.back() ? tail : nullptr;
     if (s->kind == StmtKind::Label) dead = false;  // a jump may reach it
     if (dead && opt_.warnings && s->kind != StmtKind::Empty && !(b_->pou && b_->pou->is_stdlib)) {
       diags_.warning("ST402", s->loc, "unreachable statement");
@@ -183,6 +186,18 @@ void Compiler::stmts(const StmtList& list) {
         s->kind == StmtKind::Jump)
       dead = true;
   }
+  loop_tail_ = tail;
+}
+
+// The end of an IF or CASE arm that other code follows: a jump to the statement's end,
+// or, when the statement ends a loop body, the loop's bottom (loop_tail_).
+void Compiler::arm_end(Label end) {
+  if (!loop_tail_) {
+    emit(Op::JMP, {Arg::target(end.id)});
+    return;
+  }
+  b_->cvt_cache.clear();  // conversions the condition made: their temporaries are free again
+  (*loop_tail_)();
 }
 
 // The labels of an outermost statement list, known before its first JMP (a jump forward).
@@ -488,7 +503,7 @@ void Compiler::if_stmt(const IfStmt& s) {
       ArmScope in(b_, branch(arm.loc, kind, s.loc, &decision, arm.body));
       stmts(arm.body);
     }
-    if (i + 1 < s.arms.size() || s.else_body) emit(Op::JMP, {Arg::target(end.id)});
+    if (i + 1 < s.arms.size() || s.else_body) arm_end(end);
     bind(next);
   }
   if (s.else_body) {
@@ -597,7 +612,7 @@ void Compiler::case_stmt(const CaseStmt& s) {
       ArmScope in(b_, branch(s.arms[a].loc, "CASE", s.loc, &decision, s.arms[a].body));
       stmts(s.arms[a].body);
     }
-    emit(Op::JMP, {Arg::target(end.id)});
+    arm_end(end);
   }
   bind(else_label);
   if (s.else_body) {
@@ -934,7 +949,14 @@ void Compiler::for_stmt(const ForStmt& s) {
     // rows; write_out stores any other before each pass).
     bind(body);
     write_out();
+    const Op step_op = int_op(down ? Op::LOOPDN_I8 : Op::LOOPUP_I8, st);
+    const std::function<void()> tail = [&] {
+      emit(step_op, {iv, step, limit, Arg::target(body.id)});
+      emit(Op::JMP, {Arg::target(exit.id)});
+    };
+    loop_tail_ = direct && opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
+    loop_tail_ = nullptr;
     counters_.resize(outer);
     if (!row_loops_.empty() && row_loops_.back().depth == outer) {
       const RowLoop& rows = row_loops_.back();
@@ -951,7 +973,7 @@ void Compiler::for_stmt(const ForStmt& s) {
     b_->loops.pop_back();
     bind(cont);
     read_back();
-    emit(int_op(down ? Op::LOOPDN_I8 : Op::LOOPUP_I8, st), {iv, step, limit, Arg::target(body.id)});
+    emit(step_op, {iv, step, limit, Arg::target(body.id)});
     write_out();
     bind(exit);
     return;
@@ -971,6 +993,7 @@ void Compiler::for_stmt(const ForStmt& s) {
   uint32_t decision = kNoBranch;
   {
     ArmScope in(b_, branch(s.loc, "FOR", s.loc, &decision, s.body));
+    loop_tail_ = nullptr;
     stmts(s.body);
   }
   b_->loops.pop_back();
@@ -998,7 +1021,17 @@ void Compiler::while_stmt(const WhileStmt& s) {
     ArmScope in(b_, branch(s.loc, "WHILE", s.loc, &decision, s.body));
     bind(body);
     b_->loops.push_back({exit, test});
+    const std::function<void()> tail = [&] {
+      const uint32_t top = b_->temp_top;
+      mark(s.cond->loc);
+      Val again = cond(*s.cond);
+      if (again.ok) branch_on(again, s.cond->loc, body, true);
+      b_->temp_top = top;
+      emit(Op::JMP, {Arg::target(exit.id)});
+    };
+    loop_tail_ = opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
+    loop_tail_ = nullptr;
     b_->loops.pop_back();
   }
   bind(test);
@@ -1016,7 +1049,17 @@ void Compiler::repeat_stmt(const RepeatStmt& s) {
   {
     ArmScope in(b_, branch(s.loc, "REPEAT", s.loc, &decision, s.body));
     bind(body);
+    const std::function<void()> tail = [&] {
+      const uint32_t top = b_->temp_top;
+      mark(s.until->loc);
+      Val again = cond(*s.until);
+      if (again.ok) branch_on(again, s.until->loc, body, false);
+      b_->temp_top = top;
+      emit(Op::JMP, {Arg::target(exit.id)});
+    };
+    loop_tail_ = s.until && opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
+    loop_tail_ = nullptr;
   }
   b_->loops.pop_back();
   bind(cont);

@@ -1,0 +1,197 @@
+// Loop tails: an IF or CASE that ends a loop body ends its arms with a copy of the loop's
+// bottom (LOOPUP/LOOPDN, the WHILE or UNTIL test, then a jump to the exit) instead of a
+// jump to the bottom. The program must compute what it computes with the jumps, in every
+// loop form, with arms nested in arms, EXIT, conditions that call functions, and in both
+// tiers; the watchdog must count the copied back edges as it counts the original.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "engine.hpp"
+#include "same_memory.hpp"
+#include "vm_run.hpp"
+
+namespace plcfi::st {
+namespace {
+
+struct Prog : vmtest::VmRun {
+  Prog(const std::string& src, bool tails) : VmRun(src, options(tails), "tails.st") {}
+  static CompileOptions options(bool tails) {
+    CompileOptions o;
+    o.loop_tails = tails;
+    return o;
+  }
+};
+
+size_t count(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+const char* kTails = R"(FUNCTION Probe : BOOL
+VAR_INPUT x : DINT; END_VAR
+VAR_IN_OUT calls : DINT; END_VAR
+calls := calls + 1;
+Probe := x > 0;
+END_FUNCTION
+
+PROGRAM P
+VAR
+  crc : WORD := 16#FFFF;
+  data : ARRAY [0..15] OF BYTE;
+  i, j, n, state, calls, seed, s, t : DINT;
+  moving : BOOL;
+  a : ARRAY [0..19] OF DINT;
+END_VAR
+seed := (seed * 1103 + 12345) MOD 65521;
+FOR i := 0 TO 15 DO
+  data[i] := DINT_TO_BYTE(seed + i * 37);
+END_FOR;
+(* FOR up: IF/ELSE ending the body *)
+FOR i := 0 TO 15 DO
+  crc := crc XOR SHL(BYTE_TO_WORD(data[i]), 8);
+  FOR j := 0 TO 7 DO
+    IF (crc AND 16#8000) <> 16#0000 THEN
+      crc := SHL(crc, 1) XOR 16#1021;
+    ELSE
+      crc := SHL(crc, 1);
+    END_IF;
+  END_FOR;
+END_FOR;
+(* FOR down by 2, IF/ELSIF/ELSE with a nested IF ending an arm, EXIT in an arm *)
+s := 0;
+FOR i := 19 TO 0 BY -2 DO
+  IF i MOD 3 = 0 THEN
+    s := s + i;
+  ELSIF i MOD 3 = 1 THEN
+    IF s > 40 THEN
+      s := s - 1;
+    ELSE
+      s := s + 2;
+    END_IF;
+  ELSIF i = 5 AND seed MOD 2 = 0 THEN
+    EXIT;
+  ELSE
+    s := s * 2;
+  END_IF;
+END_FOR;
+(* WHILE with a flag: an insertion sort, the body an IF/ELSIF/ELSE *)
+FOR i := 0 TO 19 DO
+  a[i] := (seed * (i + 3)) MOD 97;
+END_FOR;
+FOR i := 1 TO 19 DO
+  t := a[i];
+  j := i;
+  moving := TRUE;
+  WHILE moving DO
+    IF j = 0 THEN
+      moving := FALSE;
+    ELSIF a[j - 1] > t THEN
+      a[j] := a[j - 1];
+      j := j - 1;
+    ELSE
+      moving := FALSE;
+    END_IF;
+  END_WHILE;
+  a[j] := t;
+END_FOR;
+(* WHILE whose condition calls a function: evaluated once per pass, as before *)
+n := seed MOD 23 + 5;
+WHILE Probe(n, calls) DO
+  IF n MOD 2 = 0 THEN
+    n := n / 2 - 1;
+  ELSE
+    n := n - 3;
+  END_IF;
+END_WHILE;
+(* REPEAT with a CASE ending the body *)
+state := 0;
+t := 0;
+REPEAT
+  t := t + 1;
+  CASE state OF
+    0: state := 1;
+    1: state := 2;
+       s := s + t;
+    2: state := 0;
+  ELSE
+    state := 0;
+  END_CASE;
+UNTIL t >= 10 + seed MOD 5
+END_REPEAT;
+END_PROGRAM
+)";
+
+TEST(VmTails, ArmsEndingALoopBodyRunTheLoopsBottomAndComputeTheSame) {
+  Prog on(kTails, true), off(kTails, false);
+  ASSERT_TRUE(on.ok());
+  ASSERT_TRUE(off.ok());
+  const std::string dis = on.disasm(), plain = off.disasm();
+  // Copies: the CRC loop's LOOPUP (its THEN arm); the LOOPDN: the IF and both ELSIF
+  // arms (the one with EXIT as well), and the THEN arm of the IF that ends the first
+  // ELSIF arm; the WHILE tests (JMPT): the sort's IF and ELSIF arms and the THEN arm of
+  // the loop whose condition calls Probe; the UNTIL test: the three CASE arms (the
+  // ELSE falls to the bottom).
+  EXPECT_EQ(count(plain, " LOOPUP_I32") + 1, count(dis, " LOOPUP_I32")) << dis;
+  EXPECT_EQ(count(plain, " LOOPDN_I32") + 4, count(dis, " LOOPDN_I32")) << dis;
+  EXPECT_EQ(count(plain, " JMPT ") + 3, count(dis, " JMPT ")) << dis;
+  EXPECT_EQ(count(plain, " CALL ") + 1, count(dis, " CALL ")) << dis;  // Probe, in the copy of the test
+  EXPECT_GT(count(plain, " JMP "), 0u);
+  for (int scan = 0; scan < 8; ++scan) {
+    on.set("P.seed", scan * 7919);
+    off.set("P.seed", scan * 7919);
+    ASSERT_TRUE(on.scan()) << on.m->trap().message;
+    ASSERT_TRUE(off.scan()) << off.m->trap().message;
+    for (const char* v : {"P.crc", "P.s", "P.t", "P.n", "P.state", "P.calls", "P.a[0]", "P.a[7]", "P.a[19]"})
+      EXPECT_EQ(off.get(v), on.get(v)) << v << " after scan " << scan;
+  }
+  // Sorted, by hand: every element no greater than the next.
+  for (int k = 0; k < 19; ++k)
+    EXPECT_LE(on.get("P.a[" + std::to_string(k) + "]"), on.get("P.a[" + std::to_string(k + 1) + "]")) << k;
+}
+
+TEST(VmTails, TheNativeTierComputesTheSame) {
+  same_in_both_tiers("tails.st", kTails, 6, 0, [](Machine& m, int scan) {
+    std::string err;
+    auto h = resolve(m.app(), "P.seed", &err);
+    ASSERT_TRUE(h.has_value()) << err;
+    write_int(m, *h, scan * 7919);
+  });
+}
+
+// A loop that never ends through its copied back edge traps on the watchdog, as the
+// original does, after the same number of iterations.
+TEST(VmTails, TheWatchdogCountsTheCopiedBackEdges) {
+  const char* src = R"(PROGRAM P
+VAR n, k : DINT; END_VAR
+n := 0;
+WHILE n >= 0 DO
+  IF n MOD 2 = 0 THEN
+    n := n + 2;
+  ELSE
+    n := n + 1;
+  END_IF;
+  k := k + 1;
+  IF k < 1000000000 THEN
+    n := n - 2;
+  ELSE
+    k := 0;
+  END_IF;
+END_WHILE;
+END_PROGRAM
+)";
+  Prog on(src, true), off(src, false);
+  ASSERT_TRUE(on.ok());
+  ASSERT_TRUE(off.ok());
+  on.m->set_budget(5000);
+  off.m->set_budget(5000);
+  EXPECT_FALSE(on.scan());
+  EXPECT_FALSE(off.scan());
+  EXPECT_EQ(TrapKind::Watchdog, on.m->trap().kind);
+  EXPECT_EQ(off.m->trap().kind, on.m->trap().kind);
+  EXPECT_EQ(off.get("P.k"), on.get("P.k"));
+}
+
+}  // namespace
+}  // namespace plcfi::st
