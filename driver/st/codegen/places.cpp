@@ -962,24 +962,14 @@ Val Compiler::load(const Place& p) {
       return v;
     }
     case Place::K::FrameIdx: {
-      if (auto r = row_for(p)) {
-        Op op = size == 1 ? Op::LDXR1 : size == 2 ? Op::LDXR2 : size == 4 ? Op::LDXR4 : Op::LDXR8;
-        std::vector<Arg> addr{r->row, r->counter, static_cast<uint32_t>(static_cast<int32_t>(r->m)), Slot{p.off, p.sk}, p.arr_bytes};
-        if (auto stored = stored_element(op, addr, p)) {
-          v.slot = *stored;
-          return v;
-        }
-        Slot t = temp_for(p.type);
-        addr.insert(addr.begin(), Arg(t));
-        emit_list(op, addr);
-        def(t);
-        v.slot = t;
-        return v;
-      }
-      Slot idx = p.has_lin ? Slot{} : frame_idx(p);
       Op op;
       std::vector<Arg> addr;  // the operands after the destination
-      if (p.two && p.proven) {
+      const auto row = row_for(p);
+      Slot idx = row || p.has_lin ? Slot{} : frame_idx(p);
+      if (row) {
+        op = size == 1 ? Op::LDXR1 : size == 2 ? Op::LDXR2 : size == 4 ? Op::LDXR4 : Op::LDXR8;
+        addr = {row->row, row->counter, static_cast<uint32_t>(static_cast<int32_t>(row->m)), Slot{p.off, p.sk}, p.arr_bytes};
+      } else if (p.two && p.proven) {
         op = size == 1 ? Op::LDXXN1 : size == 2 ? Op::LDXXN2 : size == 4 ? Op::LDXXN4 : Op::LDXXN8;
         addr = {Slot{p.off, p.sk}, idx, static_cast<uint32_t>(p.lo), p.count, p.stride, p.idx2, static_cast<uint32_t>(p.lo2),
                 p.count2, p.stride2, unchecked_field(p)};
@@ -1010,7 +1000,7 @@ Val Compiler::load(const Place& p) {
       Slot t = temp_for(p.type);
       addr.insert(addr.begin(), Arg(t));
       emit_list(op, addr);
-      note_shift(p);
+      if (!row) note_shift(p);
       def(t);
       v.slot = t;
       return v;

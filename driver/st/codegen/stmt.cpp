@@ -1005,6 +1005,17 @@ void Compiler::for_stmt(const ForStmt& s) {
   bind(exit);
 }
 
+// A copy of a WHILE's or REPEAT's bottom for loop_tail_: the test jumping back to the body
+// (when the condition is `again`), then the jump out of the loop.
+void Compiler::bottom_test(const Expr& c, Label body, bool again, Label exit) {
+  const uint32_t top = b_->temp_top;
+  mark(c.loc);
+  Val v = cond(c);
+  if (v.ok) branch_on(v, c.loc, body, again);
+  b_->temp_top = top;
+  emit(Op::JMP, {Arg::target(exit.id)});
+}
+
 // WHILE and REPEAT test at the bottom: one conditional jump back per iteration instead of
 // a test and a jump (the VM and the native tier count a conditional jump back against the
 // watchdog, as JMPB). WHILE tests once more on entry, with its own copy of the condition,
@@ -1021,14 +1032,7 @@ void Compiler::while_stmt(const WhileStmt& s) {
     ArmScope in(b_, branch(s.loc, "WHILE", s.loc, &decision, s.body));
     bind(body);
     b_->loops.push_back({exit, test});
-    const std::function<void()> tail = [&] {
-      const uint32_t top = b_->temp_top;
-      mark(s.cond->loc);
-      Val again = cond(*s.cond);
-      if (again.ok) branch_on(again, s.cond->loc, body, true);
-      b_->temp_top = top;
-      emit(Op::JMP, {Arg::target(exit.id)});
-    };
+    const std::function<void()> tail = [&] { bottom_test(*s.cond, body, true, exit); };
     loop_tail_ = opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
     loop_tail_ = nullptr;
@@ -1049,14 +1053,7 @@ void Compiler::repeat_stmt(const RepeatStmt& s) {
   {
     ArmScope in(b_, branch(s.loc, "REPEAT", s.loc, &decision, s.body));
     bind(body);
-    const std::function<void()> tail = [&] {
-      const uint32_t top = b_->temp_top;
-      mark(s.until->loc);
-      Val again = cond(*s.until);
-      if (again.ok) branch_on(again, s.until->loc, body, false);
-      b_->temp_top = top;
-      emit(Op::JMP, {Arg::target(exit.id)});
-    };
+    const std::function<void()> tail = [&] { bottom_test(*s.until, body, false, exit); };
     loop_tail_ = s.until && opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
     loop_tail_ = nullptr;

@@ -23,11 +23,7 @@ struct Prog : vmtest::VmRun {
   }
 };
 
-size_t count(const std::string& text, const std::string& what) {
-  size_t n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using vmtest::occurrences;
 
 // Lower bounds other than 0, a row-major and a column-major walk, stores by the counter as
 // the first index, a displaced index, a descending loop and a step of 2, structure fields
@@ -129,12 +125,12 @@ TEST(VmRows, RankTwoAccessesInALoopReadTheirRowFromASlotSetOnEntry) {
   ASSERT_TRUE(on.ok());
   ASSERT_TRUE(off.ok());
   const std::string dis = on.disasm(), plain = off.disasm();
-  EXPECT_GE(count(dis, "ROWS "), 10u) << dis;
-  EXPECT_GE(count(dis, "LDXR"), 10u) << dis;
-  EXPECT_GE(count(dis, "STXR"), 6u) << dis;
-  EXPECT_EQ(0u, count(dis, "LDXXN")) << dis;  // every proven rank-2 access went through a row
-  EXPECT_EQ(0u, count(plain, "ROWS ")) << plain;
-  EXPECT_EQ(0u, count(plain, "LDXR")) << plain;
+  EXPECT_GE(occurrences(dis, "ROWS "), 10u) << dis;
+  EXPECT_GE(occurrences(dis, "LDXR"), 10u) << dis;
+  EXPECT_GE(occurrences(dis, "STXR"), 6u) << dis;
+  EXPECT_EQ(0u, occurrences(dis, "LDXXN")) << dis;  // every proven rank-2 access went through a row
+  EXPECT_EQ(0u, occurrences(plain, "ROWS ")) << plain;
+  EXPECT_EQ(0u, occurrences(plain, "LDXR")) << plain;
   for (int scan = 0; scan < 5; ++scan) {
     ASSERT_TRUE(on.scan()) << on.m->trap().message;
     ASSERT_TRUE(off.scan()) << off.m->trap().message;
@@ -178,9 +174,9 @@ END_PROGRAM
          true);
   ASSERT_TRUE(p.ok());
   const std::string dis = p.disasm();
-  EXPECT_EQ(0u, count(dis, "LDXR")) << dis;
-  EXPECT_EQ(0u, count(dis, "STXR")) << dis;
-  EXPECT_EQ(0u, count(dis, "ROWS ")) << dis;
+  EXPECT_EQ(0u, occurrences(dis, "LDXR")) << dis;
+  EXPECT_EQ(0u, occurrences(dis, "STXR")) << dis;
+  EXPECT_EQ(0u, occurrences(dis, "ROWS ")) << dis;
   ASSERT_TRUE(p.scan()) << p.m->trap().message;
   EXPECT_EQ(3 + 2, p.get("P.a[2, 3]"));
   EXPECT_EQ(4 * (0 + 1 + 4 + 3), p.get("P.s"));

@@ -14,11 +14,7 @@
 namespace plcfi::st {
 namespace {
 
-size_t count(const std::string& text, const std::string& what) {
-  size_t n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using vmtest::occurrences;
 
 struct Width {
   const char* type;
@@ -61,7 +57,7 @@ TEST(VmShifted, EveryOperationShiftAndWidthGivesWhatTwoStatementsGive) {
   const std::string dis = r.disasm();
   // f and g fused for 8 types x 3 operations x 2 shifts x 3 counts; u's two statements not.
   size_t fused = 0;
-  for (const char* name : {" ANDSHL_", " ANDSHR_", " ORSHL_", " ORSHR_", " XORSHL_", " XORSHR_"}) fused += count(dis, name);
+  for (const char* name : {" ANDSHL_", " ANDSHR_", " ORSHL_", " ORSHR_", " XORSHL_", " XORSHR_"}) fused += occurrences(dis, name);
   // + 3: the state's xorshift steps; + 8: a's SHL (after SHR(state, 23), which stays).
   EXPECT_EQ(2u * 8 * 3 * 2 * 3 + 3 + 8, fused) << dis;
   for (int scan = 0; scan < 20; ++scan) {
@@ -105,15 +101,15 @@ END_PROGRAM
   EXPECT_EQ(0x00000003, r.get("P.r9"));  // a rotation by 1 written as two shifts
   const std::string dis = r.disasm();
   // Fused: r1, r2, r7 (the shift is DWORD, after the conversion), r8, r9 (the SHR).
-  EXPECT_EQ(2u, count(dis, " XORSHL_")) << dis;
-  EXPECT_EQ(1u, count(dis, " ORSHR_U16")) << dis;
-  EXPECT_EQ(1u, count(dis, " ANDSHR_I16")) << dis;
-  EXPECT_EQ(1u, count(dis, " XORSHR_U32")) << dis;
+  EXPECT_EQ(2u, occurrences(dis, " XORSHL_")) << dis;
+  EXPECT_EQ(1u, occurrences(dis, " ORSHR_U16")) << dis;
+  EXPECT_EQ(1u, occurrences(dis, " ANDSHR_I16")) << dis;
+  EXPECT_EQ(1u, occurrences(dis, " XORSHR_U32")) << dis;
   // Not fused: r3 and r4 (counts 0 and 16), r5 (SHLD, a variable count), r6 (20), r9's SHL.
-  EXPECT_EQ(2u, count(dis, " SHL_U16")) << dis;
-  EXPECT_EQ(1u, count(dis, " SHLD_U16")) << dis;
-  EXPECT_EQ(1u, count(dis, " SHR_U16")) << dis;
-  EXPECT_EQ(1u, count(dis, " SHL_U32")) << dis;
+  EXPECT_EQ(2u, occurrences(dis, " SHL_U16")) << dis;
+  EXPECT_EQ(1u, occurrences(dis, " SHLD_U16")) << dis;
+  EXPECT_EQ(1u, occurrences(dis, " SHR_U16")) << dis;
+  EXPECT_EQ(1u, occurrences(dis, " SHL_U32")) << dis;
 }
 
 }  // namespace

@@ -15,11 +15,7 @@
 namespace plcfi::st {
 namespace {
 
-size_t count(const std::string& text, const std::string& what) {
-  size_t n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using vmtest::occurrences;
 
 // `@` marks where a store is followed by a load of the same element; `apart` puts a
 // statement there, which keeps every load.
@@ -110,16 +106,16 @@ TEST(VmStored, ALoadRightAfterAStoreOfTheElementReadsTheStoredValue) {
   // recs[j].x := 5 (a constant, LDXS), b[i, k] (row offsets: LDXR), b[n, m] and c[m, m]
   // (LDXX), flags[i * 8 + k] (LDXL). Kept: the a[i] in the IF's body (a jump between),
   // recs[i].x after the store of .f (another field), the loads after those.
-  EXPECT_EQ(count(kept, " LDXN4") - 1, count(dis, " LDXN4")) << dis;
-  EXPECT_EQ(count(kept, " LDX4") - 1, count(dis, " LDX4")) << dis;
-  EXPECT_EQ(count(kept, " LDXSN2") - 1, count(dis, " LDXSN2")) << dis;
-  EXPECT_EQ(count(kept, " LDXSN8") - 1, count(dis, " LDXSN8")) << dis;
-  EXPECT_EQ(count(kept, " LDXSN1") - 1, count(dis, " LDXSN1")) << dis;
-  EXPECT_EQ(count(kept, " LDXS2") - 1, count(dis, " LDXS2")) << dis;
-  EXPECT_EQ(count(kept, " LDXR2") - 1, count(dis, " LDXR2")) << dis;
-  EXPECT_EQ(count(kept, " LDXX2") - 1, count(dis, " LDXX2")) << dis;
-  EXPECT_EQ(count(kept, " LDXX4") - 1, count(dis, " LDXX4")) << dis;
-  EXPECT_EQ(count(kept, " LDXL1") - 1, count(dis, " LDXL1")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXN4") - 1, occurrences(dis, " LDXN4")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDX4") - 1, occurrences(dis, " LDX4")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXSN2") - 1, occurrences(dis, " LDXSN2")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXSN8") - 1, occurrences(dis, " LDXSN8")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXSN1") - 1, occurrences(dis, " LDXSN1")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXS2") - 1, occurrences(dis, " LDXS2")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXR2") - 1, occurrences(dis, " LDXR2")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXX2") - 1, occurrences(dis, " LDXX2")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXX4") - 1, occurrences(dis, " LDXX4")) << dis;
+  EXPECT_EQ(occurrences(kept, " LDXL1") - 1, occurrences(dis, " LDXL1")) << dis;
   for (int scan = 0; scan < 5; ++scan) {
     ASSERT_TRUE(next.scan()) << next.m->trap().message;
     ASSERT_TRUE(apart.scan()) << apart.m->trap().message;
@@ -168,7 +164,7 @@ END_PROGRAM
   EXPECT_EQ(1000, r.get("P.y"));  // element 3, read after the store moved the index
   EXPECT_EQ(42, r.get("P.z"));
   const std::string dis = r.disasm();
-  EXPECT_EQ(2u, count(dis, " LDX4")) << dis;  // both loads stay
+  EXPECT_EQ(2u, occurrences(dis, " LDX4")) << dis;  // both loads stay
 }
 
 }  // namespace

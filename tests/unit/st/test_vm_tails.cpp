@@ -23,11 +23,7 @@ struct Prog : vmtest::VmRun {
   }
 };
 
-size_t count(const std::string& text, const std::string& what) {
-  size_t n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using vmtest::occurrences;
 
 const char* kTails = R"(FUNCTION Probe : BOOL
 VAR_INPUT x : DINT; END_VAR
@@ -133,11 +129,11 @@ TEST(VmTails, ArmsEndingALoopBodyRunTheLoopsBottomAndComputeTheSame) {
   // ELSIF arm; the WHILE tests (JMPT): the sort's IF and ELSIF arms and the THEN arm of
   // the loop whose condition calls Probe; the UNTIL test: the three CASE arms (the
   // ELSE falls to the bottom).
-  EXPECT_EQ(count(plain, " LOOPUP_I32") + 1, count(dis, " LOOPUP_I32")) << dis;
-  EXPECT_EQ(count(plain, " LOOPDN_I32") + 4, count(dis, " LOOPDN_I32")) << dis;
-  EXPECT_EQ(count(plain, " JMPT ") + 3, count(dis, " JMPT ")) << dis;
-  EXPECT_EQ(count(plain, " CALL ") + 1, count(dis, " CALL ")) << dis;  // Probe, in the copy of the test
-  EXPECT_GT(count(plain, " JMP "), 0u);
+  EXPECT_EQ(occurrences(plain, " LOOPUP_I32") + 1, occurrences(dis, " LOOPUP_I32")) << dis;
+  EXPECT_EQ(occurrences(plain, " LOOPDN_I32") + 4, occurrences(dis, " LOOPDN_I32")) << dis;
+  EXPECT_EQ(occurrences(plain, " JMPT ") + 3, occurrences(dis, " JMPT ")) << dis;
+  EXPECT_EQ(occurrences(plain, " CALL ") + 1, occurrences(dis, " CALL ")) << dis;  // Probe, in the copy of the test
+  EXPECT_GT(occurrences(plain, " JMP "), 0u);
   for (int scan = 0; scan < 8; ++scan) {
     on.set("P.seed", scan * 7919);
     off.set("P.seed", scan * 7919);

@@ -11,6 +11,13 @@
 
 namespace plcfi::st::vmtest {
 
+// How often `what` occurs in `text` (instructions in a listing).
+inline size_t occurrences(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
 struct VmRun {
   std::unique_ptr<Build> b;
   std::unique_ptr<Machine> m;
