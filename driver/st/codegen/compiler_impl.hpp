@@ -450,7 +450,7 @@ class Compiler {
   // the loop's exit), which spares the jump on every pass through the arm. Null elsewhere.
   const std::function<void()>* loop_tail_ = nullptr;
   void arm_end(Label end);
-  void bottom_test(const Expr& c, Label body, bool again, Label exit);
+  void bottom_test(const Expr& c, Label body, bool again);
   // What row_candidates looks for: accesses by `counter` and one of `outer` (the counters
   // of the proven loops around it), none by `inner` (counters of loops nested in it, whose
   // accesses those loops keep rows for).

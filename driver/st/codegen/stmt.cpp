@@ -1005,15 +1005,15 @@ void Compiler::for_stmt(const ForStmt& s) {
   bind(exit);
 }
 
-// A copy of a WHILE's or REPEAT's bottom for loop_tail_: the test jumping back to the body
-// (when the condition is `again`), then the jump out of the loop.
-void Compiler::bottom_test(const Expr& c, Label body, bool again, Label exit) {
+// A WHILE's or REPEAT's bottom: the test jumping back to the body when the condition is
+// `again`. Laid down after the body, and copied into the arms of a statement ending it
+// (loop_tail_), there followed by a jump out of the loop.
+void Compiler::bottom_test(const Expr& c, Label body, bool again) {
   const uint32_t top = b_->temp_top;
   mark(c.loc);
   Val v = cond(c);
   if (v.ok) branch_on(v, c.loc, body, again);
   b_->temp_top = top;
-  emit(Op::JMP, {Arg::target(exit.id)});
 }
 
 // WHILE and REPEAT test at the bottom: one conditional jump back per iteration instead of
@@ -1032,17 +1032,17 @@ void Compiler::while_stmt(const WhileStmt& s) {
     ArmScope in(b_, branch(s.loc, "WHILE", s.loc, &decision, s.body));
     bind(body);
     b_->loops.push_back({exit, test});
-    const std::function<void()> tail = [&] { bottom_test(*s.cond, body, true, exit); };
+    const std::function<void()> tail = [&] {
+      bottom_test(*s.cond, body, true);
+      emit(Op::JMP, {Arg::target(exit.id)});
+    };
     loop_tail_ = opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
     loop_tail_ = nullptr;
     b_->loops.pop_back();
   }
   bind(test);
-  mark(s.cond->loc);
-  c = cond(*s.cond);
-  if (c.ok) branch_on(c, s.cond->loc, body, true);
-  b_->temp_top = saved;
+  bottom_test(*s.cond, body, true);
   bind(exit);
 }
 
@@ -1053,7 +1053,10 @@ void Compiler::repeat_stmt(const RepeatStmt& s) {
   {
     ArmScope in(b_, branch(s.loc, "REPEAT", s.loc, &decision, s.body));
     bind(body);
-    const std::function<void()> tail = [&] { bottom_test(*s.until, body, false, exit); };
+    const std::function<void()> tail = [&] {
+      bottom_test(*s.until, body, false);
+      emit(Op::JMP, {Arg::target(exit.id)});
+    };
     loop_tail_ = s.until && opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
     loop_tail_ = nullptr;
@@ -1061,9 +1064,7 @@ void Compiler::repeat_stmt(const RepeatStmt& s) {
   b_->loops.pop_back();
   bind(cont);
   if (s.until) {
-    mark(s.until->loc);
-    Val c = cond(*s.until);
-    if (c.ok) branch_on(c, s.until->loc, body, false);
+    bottom_test(*s.until, body, false);
   } else {
     emit(Op::JMPB, {Arg::target(body.id)});
   }
