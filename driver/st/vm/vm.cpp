@@ -6,6 +6,7 @@
 #include "cpp_functions.hpp"
 #include "wide.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -27,6 +28,10 @@ template <class T> inline T fmul(T a, T b) { return a * b; }
 template <class T> inline T band(T a, T b) { return static_cast<T>(a & b); }
 template <class T> inline bool jge(T a, T b) { return a >= b; }
 inline bool jnlt(float a, float b) { return !(a < b); }
+// The watchdog's trap message: a loop jumped back more often than `limit` allows.
+std::string watchdog_message(uint64_t limit) {
+  return fmt::format("more than {} loop iterations in one call (endless loop?)", limit);
+}
 inline bool overlap(uint32_t a, uint32_t na, uint32_t b, uint32_t nb) {
   return static_cast<uint64_t>(a) < static_cast<uint64_t>(b) + nb && static_cast<uint64_t>(b) < static_cast<uint64_t>(a) + na;
 }
@@ -208,7 +213,7 @@ struct NativeBridge {
           break;
         case TrapKind::RangeError: msg = fmt::format("value {} outside subrange {}..{}", num(a), num(b), num(cc)); break;
         case TrapKind::NullReference: msg = "dereference of a null reference"; break;
-        case TrapKind::Watchdog: msg = fmt::format("more than {} loop iterations in one call (endless loop?)", vm.budget_limit_); break;
+        case TrapKind::Watchdog: msg = watchdog_message(vm.budget_limit_); break;
         case TrapKind::CallDepth: msg = a == 1 ? "method stack overflow (recursion?)" : "call depth exceeded (recursion?)"; break;
         case TrapKind::NotImplemented: msg = "the instance's type does not implement this method"; break;
         case TrapKind::BadAddress: msg = fmt::format("address {} outside memory", static_cast<uint64_t>(a)); break;
@@ -279,13 +284,11 @@ bool Machine::call_native(const void* fn, uint8_t* base) {
 //                         value is handed to T in a register, which spares T the reload
 //                         (store-to-load latency is most of the cost of a chain);
 //   FF3(H, T, B|C, U, B|C)  the same along a chain of three;
-//   SUM(B|C)              the loop `s := s + a[i]` as a whole (FUSED_SUM below).
 // The sequences are the most frequent ones in the MATIEC kernels and the stamping program
 // (counted per dispatch): argument moves and calls, loop bodies, arithmetic chains, REAL
 // compare-and-jump with its coverage bit. (A DINT product added in the same expression is
 // one MADD_I32, which stands for the MUL_I32+ADD_I32 pairs and triples counted there.)
-#define PLCFI_FUSED(P, F, P3, FF3, SUM)                                                     \
-  SUM(B) SUM(C)                                                                           \
+#define PLCFI_FUSED(P, F, P3, FF3)                                                          \
   FF3(MUL_I32, DIVK_I32, B, JGE_I32, B) FF3(MUL_I32, DIVK_I32, B, JGE_I32, C)             \
   FF3(SUB_F32, MUL_F32, C, ADD_F32, C)                                                    \
   FF3(MUL_F32, ADD_F32, B, JNLT_F32, C) FF3(MUL_F32, ADD_F32, B, JNLT_F32, B)             \
@@ -307,7 +310,8 @@ bool Machine::call_native(const void* fn, uint8_t* base) {
   P(ADD_I32, LOOPUP_I16) P(ADD_I32, LOOPUP_I32) P(ADD_F32, MOV4) P(SUB_I32, MOV4)         \
   P(LDXH4, LDXH4) P(EQ_I16, MOV8) P(BAND, MOV1)
 
-void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules) {
+void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules,
+                          int32_t reduction) {
   const std::vector<uint32_t>& code = app_->code;
   exec_ = code;
   fused_.clear();
@@ -345,6 +349,155 @@ void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRu
     }
     pc = next;
   }
+  find_reductions(reduction);
+}
+
+// Reduction loops: a FOR loop (LOOPUP/LOOPDN back to the first instruction of its body)
+// whose body is nothing but one or two element loads indexed by the counter and the
+// accumulation of what they loaded into one variable s:
+//   DINT  s := s + a[i]           ADD_I32            s := s + a[i] * b[i]   MADD_I32
+//   REAL  s := s + a[i]           ADD_F32            s := s + a[i] * b[i]   MUL_F32, ADD_F32
+// with any of the element accesses the compiler emits for 4-byte elements (checked or
+// proven rank 1, a field of a structure element, a row of a rank-2 array in a FOR). Such
+// a loop runs in one handler that keeps the counter and s in registers from one
+// iteration to the next (run_reduction). It stores what the instructions store, in their
+// order, every iteration, so memory is exact whenever the loop ends; an index the check
+// refuses hands over to the plain instruction at that point, which traps as ever.
+// Only when nothing the loop stores overlaps what it reads besides (the step, the limit,
+// a row's offset, the arrays' bytes): then those stay as read on entry.
+void Machine::find_reductions(int32_t offset) {
+  reductions_.clear();
+  const std::vector<uint32_t>& code = app_->code;
+  const auto n = static_cast<uint32_t>(code.size());
+  auto op_at = [&](uint32_t pc) { return static_cast<Op>(code[pc]); };
+  auto length = [&](uint32_t pc) -> uint32_t {
+    uint32_t op = code[pc];
+    uint32_t len = op < static_cast<uint32_t>(Op::Count_) ? op_length(&code[pc]) : 0;
+    return len <= n - pc ? len : 0;
+  };
+  // One element load of the body at pc, indexed by `counter`: its extent in the frame.
+  auto element = [&](uint32_t pc, bool i16, uint32_t counter, Reduction::Load* l, uint32_t* from, uint64_t* bytes) {
+    const uint32_t* w = &code[pc];
+    const Op op = op_at(pc);
+    const bool h = op == Op::LDXH4 || op == Op::LDXSH4;
+    if (h != i16) return false;
+    l->pc = pc;
+    l->dst = w[1];
+    l->row = Reduction::kNoRow;
+    switch (op) {
+      case Op::LDX4: case Op::LDXH4: case Op::LDXN4:
+        l->at = w[2];
+        l->lo = static_cast<int32_t>(w[4]);
+        l->n = op == Op::LDXN4 ? UINT64_MAX : w[5];
+        l->stride = 4;
+        *from = w[2];
+        *bytes = uint64_t{w[5]} * 4;
+        break;
+      case Op::LDXS4: case Op::LDXSH4: case Op::LDXSN4:
+        l->at = w[2] + w[7];
+        l->lo = static_cast<int32_t>(w[4]);
+        l->n = op == Op::LDXSN4 ? UINT64_MAX : w[5];
+        l->stride = w[6];
+        *from = w[2];
+        *bytes = uint64_t{w[5]} * w[6];
+        break;
+      case Op::LDXR4:
+        l->at = 0;
+        l->row = w[2];
+        l->lo = 0;
+        l->n = UINT64_MAX;
+        l->stride = static_cast<int32_t>(w[4]);
+        *from = w[5];
+        *bytes = w[6];
+        break;
+      default:
+        return false;
+    }
+    return w[3] == counter;
+  };
+  uint32_t pc = 0;
+  while (pc < n) {
+    const uint32_t len = length(pc);
+    if (len == 0) break;
+    const Op op = op_at(pc);
+    const uint32_t loop = pc;
+    pc += len;
+    const bool up = op == Op::LOOPUP_I32 || op == Op::LOOPUP_I16;
+    if (!up && op != Op::LOOPDN_I32 && op != Op::LOOPDN_I16) continue;
+    const uint32_t* lw = &code[loop];
+    const uint32_t head = lw[4];
+    if (head >= loop) continue;
+    Reduction r{};
+    r.head = head;
+    r.loop = loop;
+    r.i16 = op == Op::LOOPUP_I16 || op == Op::LOOPDN_I16;
+    r.down = !up;
+    r.counter = lw[1];
+    r.step = lw[2];
+    r.limit = lw[3];
+    // The body: loads, then the accumulation, ending right at the loop instruction.
+    struct Extent { uint32_t from; uint64_t bytes; };
+    std::vector<Extent> reads;  // what must not be stored to: arrays, rows, step, limit
+    uint32_t at = head, loads = 0;
+    while (loads < 2 && at < loop && length(at) != 0) {
+      uint32_t from = 0;
+      uint64_t bytes = 0;
+      if (!element(at, r.i16, r.counter, &r.load[loads], &from, &bytes)) break;
+      reads.push_back({from, bytes});
+      if (r.load[loads].row != Reduction::kNoRow) reads.push_back({r.load[loads].row, 4});
+      ++loads;
+      at += length(at);
+    }
+    if (loads == 0 || at >= loop || length(at) == 0) continue;
+    const uint32_t* aw = &code[at];
+    const Op acc = op_at(at);
+    const uint32_t t0 = r.load[0].dst, t1 = loads == 2 ? r.load[1].dst : UINT32_MAX;
+    auto is_pair = [&](uint32_t x, uint32_t y) { return (x == t0 && y == t1) || (x == t1 && y == t0); };
+    std::vector<Extent> stores = {{r.counter, r.i16 ? 2u : 4u}, {t0, 4}};
+    if (loads == 2) stores.push_back({t1, 4});
+    uint32_t after = at + length(at);
+    if (loads == 1 && (acc == Op::ADD_I32 || acc == Op::ADD_F32) && aw[1] != t0 &&
+        ((aw[2] == aw[1] && aw[3] == t0) || (aw[2] == t0 && aw[3] == aw[1]))) {
+      r.kind = acc == Op::ADD_I32 ? Reduction::SumI32 : Reduction::SumF32;
+      r.sum = aw[1];
+      r.sum_first = aw[2] == aw[1];
+    } else if (loads == 2 && acc == Op::MADD_I32 && aw[1] == aw[4] && is_pair(aw[2], aw[3])) {
+      r.kind = Reduction::MacI32;
+      r.sum = aw[1];
+      r.swap_mul = aw[2] == t1;
+    } else if (loads == 2 && acc == Op::MUL_F32 && is_pair(aw[2], aw[3]) && after < loop && length(after) != 0 &&
+               op_at(after) == Op::ADD_F32) {
+      const uint32_t* bw = &code[after];
+      const uint32_t u = aw[1];
+      if (!((bw[2] == bw[1] && bw[3] == u) || (bw[2] == u && bw[3] == bw[1]))) continue;
+      r.kind = Reduction::MacF32;
+      r.product = u;
+      r.swap_mul = aw[2] == t1;
+      r.sum = bw[1];
+      r.sum_first = bw[2] == bw[1];
+      stores.push_back({u, 4});
+      after += length(after);
+    } else {
+      continue;
+    }
+    if (after != loop) continue;
+    stores.push_back({r.sum, 4});
+    reads.push_back({r.step, r.i16 ? 2u : 4u});
+    reads.push_back({r.limit, r.i16 ? 2u : 4u});
+    auto hits = [](const Extent& a, const Extent& b) {
+      return uint64_t{a.from} < uint64_t{b.from} + b.bytes && uint64_t{b.from} < uint64_t{a.from} + a.bytes;
+    };
+    bool disjoint = true;
+    for (size_t i = 0; i < stores.size(); ++i) {
+      for (size_t j = i + 1; j < stores.size(); ++j) disjoint = disjoint && !hits(stores[i], stores[j]);
+      for (const Extent& e : reads) disjoint = disjoint && !hits(stores[i], e);
+    }
+    if (!disjoint) continue;
+    exec_[head] = static_cast<uint32_t>(offset);
+    std::erase_if(fused_, [&](const auto& f) { return f.first == head; });
+    reductions_.push_back(r);
+  }
+  std::sort(reductions_.begin(), reductions_.end(), [](const Reduction& a, const Reduction& b) { return a.head < b.head; });
 }
 
 std::vector<std::pair<uint32_t, std::string>> Machine::superinstructions() const {
@@ -354,8 +507,134 @@ std::vector<std::pair<uint32_t, std::string>> Machine::superinstructions() const
     if (f->third != Op::Count_) name += std::string("+") + op_info(f->third).name;
     out.emplace_back(pc, std::move(name));
   }
+  // A reduction loop is named by the instructions it runs, the loop's included.
+  for (const Reduction& r : reductions_) {
+    std::string name;
+    for (uint32_t pc = r.head; pc <= r.loop; pc += op_length(&app_->code[pc]))
+      name += (name.empty() ? "" : "+") + std::string(op_info(static_cast<Op>(app_->code[pc])).name);
+    out.emplace_back(r.head, std::move(name));
+  }
+  std::sort(out.begin(), out.end());
   return out;
 }
+
+namespace {
+// How a reduction loop handed back: past the loop (pc after it), to the plain instruction
+// at pc (an index its check refuses), or out of loop budget at the loop instruction.
+struct ReductionExit {
+  enum How : uint8_t { Done, Plain, Watchdog };
+  uint32_t pc;
+  How how;
+};
+
+// One iteration's accumulation of the loaded words v into s (u: the REAL product).
+template <Machine::Reduction::Kind K, class S>
+inline void accumulate(const Machine::Reduction& r, const uint32_t* v, S& s, float& u) {
+  using R = Machine::Reduction;
+  if constexpr (K == R::SumI32) {
+    s = wadd<int32_t>(s, static_cast<int32_t>(v[0]));
+  } else if constexpr (K == R::MacI32) {
+    s = wadd<int32_t>(wmul<int32_t>(static_cast<int32_t>(v[0]), static_cast<int32_t>(v[1])), s);
+  } else if constexpr (K == R::SumF32) {
+    const float t = std::bit_cast<float>(v[0]);
+    s = r.sum_first ? s + t : t + s;
+  } else {
+    u = std::bit_cast<float>(v[r.swap_mul ? 1 : 0]) * std::bit_cast<float>(v[r.swap_mul ? 0 : 1]);
+    s = r.sum_first ? s + u : u + s;
+  }
+  (void)u;
+}
+
+// The frame offset of a load's element `lo`: a row's comes from its slot.
+inline int64_t element_base(const Machine::Reduction::Load& d, const uint8_t* base) {
+  return d.row != Machine::Reduction::kNoRow ? int64_t{ld<int32_t>(base + d.row)} : int64_t{d.at};
+}
+
+// Runs a reduction loop (Machine::find_reductions) from its first load; C is the
+// counter's type. The step, the limit and the rows are read on entry (nothing in the
+// loop stores to them). When the indices of all the runs of the body from here and its
+// jumps back are known on entry to lie inside the arrays and the budget, the loop runs
+// without checks and stores what its last iteration stored when it ends (nothing else
+// runs in between). Otherwise it stores every iteration's values as the instructions do,
+// and hands an index its check refuses to the plain instruction, which traps.
+template <class C, bool Down, Machine::Reduction::Kind K>
+ReductionExit run_reduction(const Machine::Reduction& r, uint8_t* base, int64_t& budget) {
+  using R = Machine::Reduction;
+  constexpr int kLoads = K == R::SumI32 || K == R::SumF32 ? 1 : 2;
+  using S = std::conditional_t<K == R::SumI32 || K == R::MacI32, int32_t, float>;
+  const C step = ld<C>(base + r.step), limit = ld<C>(base + r.limit);
+  C i = ld<C>(base + r.counter);
+  S s = ld<S>(base + r.sum);
+  float u = 0;
+  uint32_t v[2] = {};
+  if (Down ? step < 0 : step > 0) {
+    const int64_t i0 = i, by = step, diff = Down ? i0 - limit : int64_t{limit} - i0;
+    const int64_t more = diff <= 0 ? 0 : by == 1 || by == -1 ? diff : diff / (Down ? -by : by);
+    const int64_t last = i0 + more * by;
+    bool inside = more <= budget;
+    for (int l = 0; l < kLoads; ++l) {
+      const R::Load& d = r.load[l];
+      const int64_t e0 = i0 - d.lo, e1 = last - d.lo;
+      if (d.n != UINT64_MAX) inside = inside && std::min(e0, e1) >= 0 && static_cast<uint64_t>(std::max(e0, e1)) < d.n;
+    }
+    if (inside) {
+      const uint8_t* at[2] = {};
+      int64_t dd[2] = {};
+      for (int l = 0; l < kLoads; ++l) {
+        at[l] = base + element_base(r.load[l], base) + (i0 - r.load[l].lo) * r.load[l].stride;
+        dd[l] = by * r.load[l].stride;
+      }
+      for (int64_t k = 0; k <= more; ++k) {
+        for (int l = 0; l < kLoads; ++l) v[l] = ld<uint32_t>(at[l] + k * dd[l]);
+        accumulate<K>(r, v, s, u);
+      }
+      for (int l = 0; l < kLoads; ++l) st<uint32_t>(base + r.load[l].dst, v[l]);
+      if constexpr (K == R::MacF32) st<float>(base + r.product, u);
+      st<S>(base + r.sum, s);
+      C next;
+      (void)__builtin_add_overflow(static_cast<C>(last), step, &next);  // stored wrapped, as the loop does
+      st<C>(base + r.counter, next);
+      budget -= more;
+      return {r.loop + 5, ReductionExit::Done};
+    }
+  }
+  for (;;) {
+    for (int l = 0; l < kLoads; ++l) {
+      const R::Load& d = r.load[l];
+      const int64_t e = int64_t{i} - d.lo;
+      if (static_cast<uint64_t>(e) >= d.n) return {d.pc, ReductionExit::Plain};
+      v[l] = ld<uint32_t>(base + element_base(d, base) + e * d.stride);
+      st<uint32_t>(base + d.dst, v[l]);
+    }
+    accumulate<K>(r, v, s, u);
+    if constexpr (K == R::MacF32) st<float>(base + r.product, u);
+    st<S>(base + r.sum, s);
+    C next;
+    const bool ovf = __builtin_add_overflow(i, step, &next);
+    st<C>(base + r.counter, next);
+    if (ovf || (Down ? next < limit : next > limit)) return {r.loop + 5, ReductionExit::Done};
+    if (--budget < 0) return {r.loop, ReductionExit::Watchdog};
+    i = next;
+  }
+}
+
+template <class C, bool Down>
+ReductionExit run_reduction(const Machine::Reduction& r, uint8_t* base, int64_t& budget) {
+  using R = Machine::Reduction;
+  switch (r.kind) {
+    case R::SumI32: return run_reduction<C, Down, R::SumI32>(r, base, budget);
+    case R::MacI32: return run_reduction<C, Down, R::MacI32>(r, base, budget);
+    case R::SumF32: return run_reduction<C, Down, R::SumF32>(r, base, budget);
+    case R::MacF32: break;
+  }
+  return run_reduction<C, Down, R::MacF32>(r, base, budget);
+}
+
+ReductionExit run_reduction(const Machine::Reduction& r, uint8_t* base, int64_t& budget) {
+  if (r.i16) return r.down ? run_reduction<int16_t, true>(r, base, budget) : run_reduction<int16_t, false>(r, base, budget);
+  return r.down ? run_reduction<int32_t, true>(r, base, budget) : run_reduction<int32_t, false>(r, base, budget);
+}
+}  // namespace
 
 bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_io) {
   // Handler addresses as offsets from the first handler, one per opcode.
@@ -370,16 +649,14 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
 #define RULE_F(H, T, K) {Op::H, Op::T, Op::Count_, FUSE_##K, 0, LABEL_OFFSET(L_F_##H##_##T##_##K)},
 #define RULE_P3(H, T, U) {Op::H, Op::T, Op::U, 0, 0, LABEL_OFFSET(L_P3_##H##_##T##_##U)},
 #define RULE_FF3(H, T, K, U, K2) {Op::H, Op::T, Op::U, FUSE_##K, FUSE_##K2, LABEL_OFFSET(L_FF3_##H##_##T##_##K##_##U##_##K2)},
-#define RULE_SUM(K) {Op::LDXH4, Op::ADD_I32, Op::LOOPUP_I16, FUSE_##K, 0, LABEL_OFFSET(L_SUM_##K)},
-      PLCFI_FUSED(RULE_P, RULE_F, RULE_P3, RULE_FF3, RULE_SUM)
-#undef RULE_SUM
+      PLCFI_FUSED(RULE_P, RULE_F, RULE_P3, RULE_FF3)
 #undef RULE_FF3
 #undef RULE_P
 #undef RULE_F
 #undef RULE_P3
   };
   if (exec_.size() != app_->code.size()) [[unlikely]]
-    thread_code(kOffsets, LABEL_OFFSET(L_INVALID), kFused, std::size(kFused));
+    thread_code(kOffsets, LABEL_OFFSET(L_INVALID), kFused, std::size(kFused), LABEL_OFFSET(L_REDUCE));
   const char* const handlers = static_cast<const char*>(&&L_NOP);
   uint8_t* const mem = mem_.data();
   const uint64_t msize = mem_.size();
@@ -408,7 +685,7 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
 #define BACKJUMP()                                                                              \
   if (--budget < 0)                                                                             \
     return fail(TrapKind::Watchdog, pc,                                                         \
-                fmt::format("more than {} loop iterations in one call (endless loop?)", budget_limit_))
+                watchdog_message(budget_limit_))
   // A taken conditional jump to an earlier instruction is a loop's back edge (WHILE and
   // REPEAT test at the bottom): it counts against the watchdog, as JMPB does.
 #define TAKE(k)                                  \
@@ -990,53 +1267,22 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); FALL(3);
     MV_##T(K, v, w) pc += 1 + HL_##T;                                           \
     TV_##U(K2, NEXT, w)                                                         \
   }
-#define THEN_LOOPUP_I16(n) pc += 1 + n; goto L_LOOPUP_I16
-// The loop `FOR i := .. DO s := s + a[i]; END_FOR` (LDXH4 t := a[i]; ADD_I32 s := s + t;
-// LOOPUP_I16 on i back to the LDXH4): the whole loop in one handler, i and s carried in
-// registers from one iteration to the next. Every iteration stores t, s and i as the three
-// instructions do, so memory is exact whenever the loop ends or traps; the array, the
-// step and the limit are read from memory each time. Only when the three store to
-// disjoint slots (otherwise, and when the loop jumps elsewhere, the three run as a triple).
-#define FUSED_SUM(K)                                                                               \
-  L_SUM_##K: {                                                                                     \
-    const uint32_t* const x = pc;                                                                  \
-    const uint32_t* const a = pc + 6;                                                              \
-    const uint32_t* const l = pc + 10;                                                             \
-    const uint32_t acc = a[FUSE_##K == FUSE_C ? 2 : 3];                                            \
-    if (l[4] != static_cast<uint32_t>(x - code) || l[1] != x[3] || acc != a[1] || overlap(x[1], 4, a[1], 4) || \
-        overlap(x[1], 4, l[1], 2) || overlap(a[1], 4, l[1], 2)) {                                  \
-      HV_LDXH4 pc += 6;                                                                            \
-      TV_ADD_I32(K, THEN_LOOPUP_I16, v)                                                            \
-    }                                                                                              \
-    int16_t i = ld<int16_t>(base + x[3]);                                                          \
-    int32_t s = ld<int32_t>(base + a[1]);                                                          \
-    for (;;) {                                                                                     \
-      int64_t e = static_cast<int64_t>(i) - static_cast<int32_t>(x[4]);                            \
-      if (e < 0 || e >= static_cast<int64_t>(x[5])) goto L_LDXH4; /* traps there, pc = x */       \
-      int32_t t = ld<int32_t>(base + x[2] + e * 4);                                                \
-      st<int32_t>(base + x[1], t);                                                                 \
-      s = wadd<int32_t>(s, t);                                                                     \
-      st<int32_t>(base + a[1], s);                                                                 \
-      int16_t next;                                                                                \
-      bool ovf = __builtin_add_overflow(i, ld<int16_t>(base + l[2]), &next);                       \
-      st<int16_t>(base + l[1], next);                                                              \
-      if (ovf || next > ld<int16_t>(base + l[3])) {                                                \
-        pc = l + 5;                                                                                \
-        DISPATCH();                                                                                \
-      }                                                                                            \
-      pc = l;                                                                                      \
-      BACKJUMP();                                                                                  \
-      pc = x;                                                                                      \
-      i = next;                                                                                    \
-    }                                                                                              \
-  }
-  PLCFI_FUSED(FUSED_P, FUSED_F, FUSED_P3, FUSED_FF3, FUSED_SUM)
-#undef FUSED_SUM
+  PLCFI_FUSED(FUSED_P, FUSED_F, FUSED_P3, FUSED_FF3)
+  // A reduction loop as a whole (find_reductions, run_reduction).
+L_REDUCE: {
+  const auto head = static_cast<uint32_t>(pc - code);
+  const auto r = std::lower_bound(reductions_.begin(), reductions_.end(), head,
+                                  [](const Reduction& x, uint32_t h) { return x.head < h; });
+  const ReductionExit x = run_reduction(*r, base, budget);
+  pc = code + x.pc;
+  if (x.how == ReductionExit::Done) DISPATCH();
+  if (x.how == ReductionExit::Plain) goto* static_cast<const void*>(handlers + kOffsets[app_->code[x.pc]]);
+  return fail(TrapKind::Watchdog, pc, watchdog_message(budget_limit_));
+}
 #undef FUSED_FF3
 #undef FUSED_P
 #undef FUSED_F
 #undef FUSED_P3
-#undef THEN_LOOPUP_I16
 #undef ELEM_INDEX
 #undef ELEM_INDEX_AS
 

@@ -188,7 +188,35 @@ class Machine {
     uint32_t operand, operand2;  // operand2: the same for the third and the second
     int32_t offset;
   };
-  void thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules);
+  void thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules,
+                   int32_t reduction);
+  // A reduction loop (see find_reductions): a FOR loop whose body accumulates one or two
+  // elements indexed by its counter, `s := s + a[i]` or `s := s + a[i] * b[i]` (DINT or
+  // REAL), run as a whole by one handler. Decoded from the code when it is threaded.
+ public:
+  struct Reduction {
+    enum Kind : uint8_t { SumI32, MacI32, SumF32, MacF32 };
+    struct Load {
+      uint32_t pc, dst;
+      uint32_t at;       // frame offset of element `lo` (a field's offset included)
+      uint32_t row;      // the slot holding the row's frame offset (LDXR), else kNoRow
+      int32_t lo;        // the index of the first element
+      uint64_t n;        // elements; UINT64_MAX when the compiler proved the index in range
+      int64_t stride;
+    };
+    static constexpr uint32_t kNoRow = UINT32_MAX;
+    uint32_t head, loop;  // the first load and the loop instruction (LOOPUP/LOOPDN)
+    Kind kind;
+    bool i16, down;       // the counter is an INT; the loop counts down
+    bool sum_first;       // the addition reads s as its first operand (REAL keeps the order)
+    bool swap_mul;        // the product reads the second load first
+    Load load[2];
+    uint32_t sum, product;  // s; the REAL product's temporary (MacF32)
+    uint32_t counter, step, limit;
+  };
+
+ private:
+  void find_reductions(int32_t offset);
   bool call_native(const void* fn, uint8_t* base);
   bool do_assert(const uint32_t* pc, uint8_t* base);
 
@@ -201,6 +229,7 @@ class Machine {
   // (mutation analysis patches it before it makes the machines that run the mutant).
   std::vector<uint32_t> exec_;
   std::vector<std::pair<uint32_t, const FusedRule*>> fused_;  // the heads rewritten in exec_
+  std::vector<Reduction> reductions_;  // by head, ascending; their heads rewritten in exec_
   std::vector<uint8_t> mem_;
   std::vector<uint64_t> taken_, covered_;
   std::vector<uint64_t> hits_;  // index = branch id; sized by set_count_hits(true)
