@@ -120,6 +120,10 @@ struct Place {
   // or a constant (LDXL/STXL): idx not made yet, one bounds check on the wrapped sum.
   bool has_lin = false;
   Slot lin_x, lin_m, lin_y;
+  // has_lin with x * m + y known inside the dimension: one of x and m a constant, the
+  // other and y counters of proven FOR loops (see linear_in_range). A row offset may
+  // then reach the element (row_for).
+  bool lin_proven = false;
   // FrameIdx whose index was v + shift (v the DINT variable in idx, shift a small integer
   // constant): lo holds the dimension's lower bound minus shift, so the access computes
   // v - lo without the addition (see displaced_index).
@@ -429,8 +433,10 @@ class Compiler {
   const CounterRange* proven_range(Slot s) const;
   bool keeps_counter(const StmtList& body, const std::string& counter) const;
   // Rows (stmt.cpp): in a FOR loop over a proven counter, a rank-2 access indexed by the
-  // counter and by a counter of an enclosing loop reads the offset of its row (the part
-  // the loop does not change) from a slot ROWS sets on the loop's entry (LDXR/STXR).
+  // counter and by a counter of an enclosing loop, or a rank-1 access whose index is
+  // linear in the two and proven inside the array (`a[i * 8 + k]`), reads the offset of
+  // its row (the part the loop does not change) from a slot ROWS sets on the loop's entry
+  // (LDXR/STXR).
   struct RowOffset {
     int64_t k = 0;   // offset (of the field, in its element) when both counters are 0
     Slot v;          // the outer counter
@@ -465,6 +471,7 @@ class Compiler {
   };
   // How a proven rank-2 access reaches its element through a loop's row slot, if one can.
   std::optional<RowAccess> row_for(const Place& p);
+  bool linear_in_range(const Place& p, int64_t lo, int64_t hi) const;
   Val call_function(PouInfo* f, const CallExpr& c);
   // The frame set-up of a FUNCTION call: the template's bytes this call needs (calls.cpp).
   void init_function_frame(PouInfo* f, Slot frame, const std::vector<const Symbol*>& stored);

@@ -569,7 +569,8 @@ Place Compiler::index_place(Place base, const IndexExpr& e, bool for_write) {
     p.readonly = base.readonly;
     // A place read now, or stored to after a right-hand side that runs no call, may read
     // its index's variables when it is accessed.
-    if (plain && !raw16 && shift == 0 && (!for_write || defer)) take_linear_index(p.idx, &p);
+    if (plain && !raw16 && shift == 0 && (!for_write || defer) && take_linear_index(p.idx, &p))
+      p.lin_proven = linear_in_range(p, t->dims[d0].lo, t->dims[d0].hi);
     // One index, a FOR counter that stays inside the dimension (see for_stmt); displaced
     // by K, the counter's range moves by K.
     if (dyn.size() == 1 && !raw16 && !p.has_lin) {

@@ -738,6 +738,29 @@ size_t count_indexed(const Expr* e, const Compiler::RowScan& scan) {
           n += count_indexed(i.get(), scan);
         }
         if (by_counter && by_outer && simple && vars == 2) ++n;
+        // One index linear in the counter and an outer counter: v * C + w, C * v + w or
+        // w + v * C (a rank-2 table kept in a rank-1 array).
+        if (x.indices.size() == 1 && x.indices[0]->kind == ExprKind::Binary) {
+          const auto& sum = static_cast<const BinaryExpr&>(*x.indices[0]);
+          auto scaled = [](const Expr& f) -> const NameExpr* {
+            if (f.kind != ExprKind::Binary) return nullptr;
+            const auto& m = static_cast<const BinaryExpr&>(f);
+            if (m.op != BinaryOp::Mul) return nullptr;
+            if (m.lhs->kind == ExprKind::Name && m.rhs->kind == ExprKind::Literal) return &static_cast<const NameExpr&>(*m.lhs);
+            if (m.rhs->kind == ExprKind::Name && m.lhs->kind == ExprKind::Literal) return &static_cast<const NameExpr&>(*m.rhs);
+            return nullptr;
+          };
+          const NameExpr* v = sum.op == BinaryOp::Add ? scaled(*sum.lhs) : nullptr;
+          const Expr* w = sum.rhs.get();
+          if (!v && sum.op == BinaryOp::Add) {
+            v = scaled(*sum.rhs);
+            w = sum.lhs.get();
+          }
+          if (v && w->kind == ExprKind::Name) {
+            const std::string a = canon(v->name.text), b = canon(static_cast<const NameExpr&>(*w).name.text);
+            if ((a == scan.counter && among(scan.outer, b)) || (b == scan.counter && among(scan.outer, a))) ++n;
+          }
+        }
         e = x.base.get();
         break;
       }
@@ -766,8 +789,8 @@ size_t count_indexed(const Expr* e, const Compiler::RowScan& scan) {
 
 // How many row offsets a FOR loop may keep: the accesses in its body with two variable
 // indices (each plus or minus a literal, the others literals), its counter and a counter
-// of a proven loop around it. An upper bound: the compiler decides access by access
-// (row_for).
+// of a proven loop around it, or with one index linear in the two. An upper bound: the
+// compiler decides access by access (row_for).
 size_t Compiler::row_candidates(const StmtList& body, RowScan& scan) {
   size_t n = 0;
   for (const StmtPtr& sp : body) {
@@ -815,24 +838,60 @@ size_t Compiler::row_candidates(const StmtList& body, RowScan& scan) {
   return n;
 }
 
+// A DINT constant's value (a slot in the constant pool).
+static std::optional<int64_t> const_dint(const std::vector<uint8_t>& consts, Slot s) {
+  if (s.kind != SK::Const || uint64_t{s.off} + 4 > consts.size()) return std::nullopt;
+  int32_t v = 0;
+  std::memcpy(&v, consts.data() + s.off, 4);
+  return v;
+}
+
+// Whether x * m + y (a linear index, Place::has_lin) stays inside lo..hi: one of x and m
+// a constant, the other and y counters of proven FOR loops, so every value they take is
+// known (and the sum cannot wrap).
+bool Compiler::linear_in_range(const Place& p, int64_t lo, int64_t hi) const {
+  const std::optional<int64_t> cx = const_dint(b_->consts, p.lin_x), cm = const_dint(b_->consts, p.lin_m);
+  const CounterRange* v = cm ? proven_range(p.lin_x) : cx ? proven_range(p.lin_m) : nullptr;
+  const CounterRange* w = proven_range(p.lin_y);
+  if (!v || !w) return false;
+  const int64_t c = cm ? *cm : *cx;
+  const int64_t a = v->lo * c, b = v->hi * c;
+  return std::min(a, b) + w->lo >= lo && std::max(a, b) + w->hi <= hi;
+}
+
 std::optional<Compiler::RowAccess> Compiler::row_for(const Place& p) {
-  if (p.k != Place::K::FrameIdx || !p.proven || !p.two || p.sk != SK::Var || row_loops_.empty()) return std::nullopt;
+  if (p.k != Place::K::FrameIdx || p.sk != SK::Var || row_loops_.empty()) return std::nullopt;
+  const bool linear = p.has_lin && p.lin_proven;
+  if (!linear && !(p.proven && p.two)) return std::nullopt;
   const uint32_t size = p.type->size;
   if (!p.type->is_elementary() || (size != 1 && size != 2 && size != 4 && size != 8)) return std::nullopt;
-  // The innermost loop keeping rows whose counter is one of the indices; the other index
+  // Two variables and their strides in bytes: the indices of a rank-2 access, or the
+  // scaled variable and the added one of a linear index (x * m + y), whose element `lo`
+  // the offset k names.
+  Slot v0 = p.idx, v1 = p.idx2;
+  int64_t m0 = p.stride, m1 = p.stride2;
+  int64_t k = int64_t{p.off} + p.unchecked_disp();
+  if (linear) {
+    const std::optional<int64_t> cm = const_dint(b_->consts, p.lin_m), cx = const_dint(b_->consts, p.lin_x);
+    v0 = cm ? p.lin_x : p.lin_m;
+    m0 = (cm ? *cm : cx.value_or(0)) * size;
+    v1 = p.lin_y;
+    m1 = size;
+    k = int64_t{p.off} - int64_t{p.lo} * size;
+  }
+  // The innermost loop keeping rows whose counter is one of the variables; the other
   // must be a counter of a loop around it (constant while it runs).
   for (size_t li = row_loops_.size(); li-- > 0;) {
     RowLoop& loop = row_loops_[li];
-    const bool first = p.idx == loop.counter, second = p.idx2 == loop.counter;
+    const bool first = v0 == loop.counter, second = v1 == loop.counter;
     if (!first && !second) continue;
     if (first && second) return std::nullopt;
-    const Slot inner = first ? p.idx : p.idx2, outer = first ? p.idx2 : p.idx;
-    const int64_t m_inner = first ? p.stride : p.stride2, m_outer = first ? p.stride2 : p.stride;
+    const Slot inner = first ? v0 : v1, outer = first ? v1 : v0;
+    const int64_t m_inner = first ? m0 : m1, m_outer = first ? m1 : m0;
     if (inner.kind != SK::Var || outer.kind != SK::Var) return std::nullopt;
     bool around = false;
     for (size_t d = 0; d < loop.depth && d < counters_.size(); ++d) around = around || counters_[d].slot == outer;
     if (!around) return std::nullopt;
-    const int64_t k = int64_t{p.off} + p.unchecked_disp();
     auto fits = [](int64_t x) { return x >= INT32_MIN && x <= INT32_MAX; };
     if (!fits(k) || !fits(m_inner) || !fits(m_outer)) return std::nullopt;
     RowAccess a{Slot{}, inner, m_inner};

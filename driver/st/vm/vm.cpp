@@ -32,9 +32,6 @@ inline bool jnlt(float a, float b) { return !(a < b); }
 std::string watchdog_message(uint64_t limit) {
   return fmt::format("more than {} loop iterations in one call (endless loop?)", limit);
 }
-inline bool overlap(uint32_t a, uint32_t na, uint32_t b, uint32_t nb) {
-  return static_cast<uint64_t>(a) < static_cast<uint64_t>(b) + nb && static_cast<uint64_t>(b) < static_cast<uint64_t>(a) + na;
-}
 
 // SCMP and WSCMP: whether compare() result c satisfies relation rel (0 =, 1 <>, 2 <,
 // 3 <=, 4 >, 5 >=).

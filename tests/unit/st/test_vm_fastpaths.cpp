@@ -686,7 +686,7 @@ END_FUNCTION
 PROGRAM P
 VAR flat : ARRAY [0..11] OF DINT; bits : ARRAY [1..8] OF BOOL; w : ARRAY [-4..3] OF INT;
     i, k, s, c, x : DINT; n : DINT := 4; r : DINT := 1; big : DINT := 65536; bad : DINT; END_VAR
-FOR i := 0 TO 2 DO FOR k := 0 TO 3 DO flat[i * 4 + k] := i * 10 + k; END_FOR; END_FOR;
+FOR i := 0 TO 2 DO FOR k := 0 TO 3 DO flat[i * n + k] := i * 10 + k; END_FOR; END_FOR;
 s := 0;
 FOR i := 0 TO 2 DO FOR k := 0 TO 3 DO s := s + flat[k + i * n]; END_FOR; END_FOR;
 FOR i := 0 TO 3 DO bits[i * 2 + 1] := SHR(DINT_TO_WORD(i), 0) = WORD#2; bits[i * 2 + 2] := i = 1; END_FOR;

@@ -35,6 +35,7 @@ VAR
   s : DINT;
   r : LREAL;
   pad : DINT;
+  eight : DINT := 8;  (* a variable: the linear index stays LDXL, not a row *)
 END_VAR
 FOR i := 0 TO 15 DO
   seed := (seed * 1103 + 12345) MOD 65521;
@@ -77,12 +78,12 @@ b[n, m] := DINT_TO_INT(s MOD 1000);
 s := s - b[n, m];
 FOR i := 0 TO 7 DO
   FOR k := 0 TO 7 DO
-    flags[i * 8 + k] := ((s + k + i) MOD 3) = 0;
+    flags[i * eight + k] := ((s + k + i) MOD 3) = 0;
     @
-    IF flags[i * 8 + k] = bits[i * 8 + k] THEN
+    IF flags[i * eight + k] = bits[i * eight + k] THEN
       n := n + 1;
     END_IF;
-    bits[i * 8 + k] := NOT flags[i * 8 + k];
+    bits[i * eight + k] := NOT flags[i * eight + k];
   END_FOR;
 END_FOR;
 m := seed MOD 6;
@@ -104,7 +105,7 @@ TEST(VmStored, ALoadRightAfterAStoreOfTheElementReadsTheStoredValue) {
   const std::string dis = next.disasm(), kept = apart.disasm();
   // Forwarded, one load each: a[i] (LDXN), a[n] (LDX), recs[i].x, .y and .f (LDXSN),
   // recs[j].x := 5 (a constant, LDXS), b[i, k] (row offsets: LDXR), b[n, m] and c[m, m]
-  // (LDXX), flags[i * 8 + k] (LDXL). Kept: the a[i] in the IF's body (a jump between),
+  // (LDXX), flags[i * eight + k] (LDXL). Kept: the a[i] in the IF's body (a jump between),
   // recs[i].x after the store of .f (another field), the loads after those.
   EXPECT_EQ(occurrences(kept, " LDXN4") - 1, occurrences(dis, " LDXN4")) << dis;
   EXPECT_EQ(occurrences(kept, " LDX4") - 1, occurrences(dis, " LDX4")) << dis;
