@@ -20,6 +20,7 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -594,8 +595,11 @@ class Translator {
       for (uint32_t wd : cov_words) o << "  uint64_t cov" << wd << " = 0;\n";
     };
     auto body = [&](uint32_t from, uint32_t to) {
-      for (uint32_t pc = from; pc < to; pc += op_length(&code_[pc])) {
+      uint32_t prev = UINT32_MAX;
+      for (uint32_t pc = from; pc < to; prev = pc, pc += op_length(&code_[pc])) {
         if (labels.count(pc)) o << " " << label(pc) << ":\n";
+        // An STXB right after the LDXB of its block, no jump between (block_copy).
+        block_load_ = prev != UINT32_MAX && !labels.count(pc) && static_cast<Op>(code_[prev]) == Op::LDXB ? prev : UINT32_MAX;
         std::string s;
         valid_ = &valid_in_[index_of_.at(pc)];
         dead_now_ = &dead_[index_of_.at(pc)];
@@ -604,6 +608,7 @@ class Translator {
       }
       valid_ = nullptr;
       dead_now_ = nullptr;
+      block_load_ = UINT32_MAX;
       return true;
     };
     // Off the end: the interpreter would go on into the next entry's code.
@@ -691,6 +696,27 @@ class Translator {
     auto it = safe_.find(pc);
     if (!valid_ || it == safe_.end()) return "memmove";
     return at + n <= it->second.lo || it->second.hi <= at ? "memcpy" : "memmove";
+  }
+
+  // An element copied to another through a temporary block, `a[j] := a[j - 1]` (LDXB T;
+  // STXB from T, nothing between): the STXB reads the source element itself, which the
+  // LDXB checked and which T cannot overlap, instead of T just stored (a load that waits
+  // for those stores). T is still written; the copy goes through a local buffer, so any
+  // overlap of the two elements is harmless. The source element's address, or nothing.
+  std::optional<std::string> block_copy(uint32_t pc) const {
+    if (block_load_ == UINT32_MAX) return std::nullopt;
+    const uint32_t* l = &code_[block_load_];
+    const uint32_t* w = &code_[pc];
+    const uint64_t t = l[1], n = l[8], arr = l[2], arr_n = uint64_t{l[5]} * l[6];
+    if (w[7] != t || w[8] != n) return std::nullopt;
+    const bool apart = (t + n <= l[3] || uint64_t{l[3]} + 4 <= t) && (t + n <= arr || arr + arr_n <= t);
+    if (!apart) return std::nullopt;
+    // The index as the LDXB read it: from its local when that holds it (only T was
+    // written since), else from memory.
+    std::string idx = fmt::format("ld<int32_t>(base + {}u)", l[3]);
+    const int key = valid_ ? find_key(l[3], "int32_t") : -1;
+    if (key >= 0 && test_bit(*valid_, key)) idx = fmt::format("((int32_t){})", key_name(key));
+    return fmt::format("base + {}u + ((int64_t){} - (int64_t){}) * {}u + {}u", l[2], idx, static_cast<int32_t>(l[4]), l[6], l[7]);
   }
 
   bool instruction(uint32_t pc, std::string* out) {
@@ -984,6 +1010,7 @@ class Translator {
                       R("int32_t", at), S(at + 1), K(at + 2), P(pc));
       std::string elem = fmt::format("base + {} + i * {} + {}", K(at - 1), K(at + 3), K(at + 4));
       if (load) s += fmt::format("std::{}(base + {}, {}, {});", fn, K(1), elem, K(8));
+      else if (auto from = block_copy(pc)) s += fmt::format("uint8_t b_[{0}]; std::memcpy(b_, {1}, {0}); std::memcpy({2}, b_, {0});", K(8), *from, elem);
       else s += fmt::format("std::{}({}, base + {}, {});", fn, elem, K(7), K(8));
       return true;
     }
@@ -1591,6 +1618,7 @@ class Translator {
   std::map<uint32_t, Prov> safe_;                 // pc -> the frame array its pointer operand points into
   std::vector<std::vector<uint64_t>> dead_;       // per instruction: the keys whose store W leaves out
   const std::vector<uint64_t>* dead_now_ = nullptr;  // during emission
+  uint32_t block_load_ = UINT32_MAX;  // during emission: the LDXB right before this instruction
   int pass_ = 0;
   // The first pass's slot analysis of each function, for the final pass.
   struct Analysis {

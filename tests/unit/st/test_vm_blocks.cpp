@@ -136,5 +136,55 @@ TEST(VmBlocks, StructuresOfEverySizeKeepTheirFieldsWhenMovedWhole) {
 
 TEST(VmBlocks, StructureMovesAgreeWithTheNativeTier) { same_in_both_tiers("blocks.st", kBlocks, 3); }
 
+// An element copied to another element (`a[j] := a[j - 1]`: LDXB to a temporary block,
+// STXB from it): the native tier copies from the source element itself. The same and
+// neighbouring elements, two arrays, indices computed into temporaries, an index the
+// STXB refuses: memory must be what the interpreter leaves, byte for byte, traps
+// included.
+const char* kElementCopies = R"(TYPE
+  Item : STRUCT id : DINT; key : INT; w : REAL; END_STRUCT;
+END_TYPE
+PROGRAM P
+VAR
+  a : ARRAY [0..9] OF Item;
+  b : ARRAY [1..4] OF Item;
+  i, j, k, n, bad : DINT;
+  flag : BOOL;
+END_VAR
+FOR i := 0 TO 9 DO
+  a[i].id := i * 11 + n; a[i].key := DINT_TO_INT(i - n); a[i].w := DINT_TO_REAL(i) * 0.5;
+END_FOR;
+FOR j := 9 TO 1 BY -1 DO
+  a[j] := a[j - 1];
+END_FOR;
+a[3] := a[3];
+FOR k := 1 TO 4 DO
+  b[k] := a[k * 2 - 1];
+END_FOR;
+IF flag THEN
+  a[0] := b[2];
+END_IF;
+a[n MOD 10] := b[(n MOD 4) + 1];
+a[bad] := b[1];
+n := n + 1;
+flag := NOT flag;
+END_PROGRAM
+)";
+
+TEST(VmBlocks, ElementToElementCopiesAgreeWithTheNativeTier) {
+  auto b = build_sources({{"blocks.st", kElementCopies}}, CompileOptions{});
+  ASSERT_TRUE(b->ok()) << b->diags.render_all();
+  std::vector<uint32_t> entries, skipped;
+  const std::string cpp = native_source(*b->app, &entries, &skipped);
+  // a[j] := a[j - 1], b[k] := a[k * 2 - 1], a[n MOD 10] := b[(n MOD 4) + 1]; the others
+  // read a constant element, which is no LDXB (a[0] := b[2] is one MOVN, a[bad] := b[1]
+  // an STXB from b[1]'s bytes).
+  EXPECT_EQ(3u, vmtest::occurrences(cpp, "uint8_t b_[12u]")) << cpp;
+  same_in_both_tiers("blocks.st", kElementCopies, 4, 0, [](Machine& m, int scan) {
+    std::string err;
+    write_int(m, *resolve(m.app(), "P.bad", &err), scan == 2 ? 10 : scan);
+  });
+}
+
 }  // namespace
 }  // namespace plcfi::st
