@@ -307,6 +307,14 @@ bool Machine::call_native(const void* fn, uint8_t* base) {
   P(ADD_I32, LOOPUP_I16) P(ADD_I32, LOOPUP_I32) P(ADD_F32, MOV4) P(SUB_I32, MOV4)         \
   P(LDXH4, LDXH4) P(EQ_I16, MOV8) P(BAND, MOV1)
 
+// The length of the instruction at pc, or 0 when the word there is no opcode or the
+// instruction runs past the end of the code.
+static uint32_t instruction_length(const std::vector<uint32_t>& code, uint32_t pc) {
+  const uint32_t op = code[pc];
+  const uint32_t len = op < static_cast<uint32_t>(Op::Count_) ? op_length(&code[pc]) : 0;
+  return len <= code.size() - pc ? len : 0;
+}
+
 void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules,
                           int32_t reduction) {
   const std::vector<uint32_t>& code = app_->code;
@@ -315,11 +323,7 @@ void Machine::thread_code(const int32_t* offsets, int32_t invalid, const FusedRu
   const auto n = static_cast<uint32_t>(code.size());
   std::vector<uint8_t> heads(static_cast<size_t>(Op::Count_), 0);  // ops that start some rule
   for (size_t r = 0; r < n_rules; ++r) heads[static_cast<size_t>(rules[r].head)] = 1;
-  auto length = [&](uint32_t pc) -> uint32_t {
-    uint32_t op = code[pc];
-    uint32_t len = op < static_cast<uint32_t>(Op::Count_) ? op_length(&code[pc]) : 0;
-    return len <= n - pc ? len : 0;
-  };
+  auto length = [&](uint32_t pc) { return instruction_length(code, pc); };
   uint32_t pc = 0;
   while (pc < n) {
     uint32_t len = length(pc);
@@ -367,11 +371,7 @@ void Machine::find_reductions(int32_t offset) {
   const std::vector<uint32_t>& code = app_->code;
   const auto n = static_cast<uint32_t>(code.size());
   auto op_at = [&](uint32_t pc) { return static_cast<Op>(code[pc]); };
-  auto length = [&](uint32_t pc) -> uint32_t {
-    uint32_t op = code[pc];
-    uint32_t len = op < static_cast<uint32_t>(Op::Count_) ? op_length(&code[pc]) : 0;
-    return len <= n - pc ? len : 0;
-  };
+  auto length = [&](uint32_t pc) { return instruction_length(code, pc); };
   // One element load of the body at pc, indexed by `counter`: its extent in the frame.
   auto element = [&](uint32_t pc, bool i16, uint32_t counter, Reduction::Load* l, uint32_t* from, uint64_t* bytes) {
     const uint32_t* w = &code[pc];
@@ -564,6 +564,8 @@ ReductionExit run_reduction(const Machine::Reduction& r, uint8_t* base, int64_t&
   S s = ld<S>(base + r.sum);
   float u = 0;
   uint32_t v[2] = {};
+  const uint8_t* at[2] = {};  // element `lo` of each access
+  for (int l = 0; l < kLoads; ++l) at[l] = base + element_base(r.load[l], base);
   if (Down ? step < 0 : step > 0) {
     const int64_t i0 = i, by = step, diff = Down ? i0 - limit : int64_t{limit} - i0;
     const int64_t more = diff <= 0 ? 0 : by == 1 || by == -1 ? diff : diff / (Down ? -by : by);
@@ -575,14 +577,14 @@ ReductionExit run_reduction(const Machine::Reduction& r, uint8_t* base, int64_t&
       if (d.n != UINT64_MAX) inside = inside && std::min(e0, e1) >= 0 && static_cast<uint64_t>(std::max(e0, e1)) < d.n;
     }
     if (inside) {
-      const uint8_t* at[2] = {};
+      const uint8_t* first[2] = {};
       int64_t dd[2] = {};
       for (int l = 0; l < kLoads; ++l) {
-        at[l] = base + element_base(r.load[l], base) + (i0 - r.load[l].lo) * r.load[l].stride;
+        first[l] = at[l] + (i0 - r.load[l].lo) * r.load[l].stride;
         dd[l] = by * r.load[l].stride;
       }
       for (int64_t k = 0; k <= more; ++k) {
-        for (int l = 0; l < kLoads; ++l) v[l] = ld<uint32_t>(at[l] + k * dd[l]);
+        for (int l = 0; l < kLoads; ++l) v[l] = ld<uint32_t>(first[l] + k * dd[l]);
         accumulate<K>(r, v, s, u);
       }
       for (int l = 0; l < kLoads; ++l) st<uint32_t>(base + r.load[l].dst, v[l]);
@@ -600,7 +602,7 @@ ReductionExit run_reduction(const Machine::Reduction& r, uint8_t* base, int64_t&
       const R::Load& d = r.load[l];
       const int64_t e = int64_t{i} - d.lo;
       if (static_cast<uint64_t>(e) >= d.n) return {d.pc, ReductionExit::Plain};
-      v[l] = ld<uint32_t>(base + element_base(d, base) + e * d.stride);
+      v[l] = ld<uint32_t>(at[l] + e * d.stride);
       st<uint32_t>(base + d.dst, v[l]);
     }
     accumulate<K>(r, v, s, u);
