@@ -307,6 +307,25 @@ bool Machine::call_native(const void* fn, uint8_t* base) {
   P(ADD_I32, LOOPUP_I16) P(ADD_I32, LOOPUP_I32) P(ADD_F32, MOV4) P(SUB_I32, MOV4)         \
   P(LDXH4, LDXH4) P(EQ_I16, MOV8) P(BAND, MOV1)
 
+// Rule 20, a conditional jump on an array element: IF flags[i] THEN, IF a[j - 1].key > x
+// THEN, WHILE buf[k] <> 0 DO, IF (data[i] AND 16#80) <> 0 THEN. An element load (a rank-1
+// array with a DINT index, checked or proven, of an elementary element or a field of a
+// structure element, or a row of a rank-2 array in a FOR loop) of a BOOL or an integer of
+// up to 32 bits, followed by a conditional jump that reads what it loaded (as either
+// operand): one handler loads the element as the load does and goes on straight to the
+// jump's handler, without a dispatch. Every such pair is fused; the list below spells out
+// the class (each access form, each conditional jump of the element's width).
+//   PLCFI_ELEM_JUMPS(X)   X(L, N, J): the load L of N bytes, then the jump J.
+#define PLCFI_ELEM_JUMPS(X)                                                                               \
+  PLCFI_ELEM_JUMPS_OF(X, LDX) PLCFI_ELEM_JUMPS_OF(X, LDXN) PLCFI_ELEM_JUMPS_OF(X, LDXS) PLCFI_ELEM_JUMPS_OF(X, LDXSN) \
+  PLCFI_ELEM_JUMPS_OF(X, LDXR)
+#define PLCFI_ELEM_JUMPS_OF(X, L)                                                                                 \
+  X(L, 1, JMPF) X(L, 1, JMPT) PLCFI_ELEM_CMP(X, L, 1, I8) PLCFI_ELEM_CMP(X, L, 1, U8) PLCFI_ELEM_CMP(X, L, 2, I16) \
+  PLCFI_ELEM_CMP(X, L, 2, U16) PLCFI_ELEM_CMP(X, L, 4, I32) PLCFI_ELEM_CMP(X, L, 4, U32)
+#define PLCFI_ELEM_CMP(X, L, N, TN)                                                                  \
+  X(L, N, JEQ_##TN) X(L, N, JNE_##TN) X(L, N, JLT_##TN) X(L, N, JGE_##TN) X(L, N, JTZ_##TN) \
+  X(L, N, JTNZ_##TN)
+
 // The length of the instruction at pc, or 0 when the word there is no opcode or the
 // instruction runs past the end of the code.
 static uint32_t instruction_length(const std::vector<uint32_t>& code, uint32_t pc) {
@@ -649,6 +668,15 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
 #define RULE_P3(H, T, U) {Op::H, Op::T, Op::U, 0, 0, LABEL_OFFSET(L_P3_##H##_##T##_##U)},
 #define RULE_FF3(H, T, K, U, K2) {Op::H, Op::T, Op::U, FUSE_##K, FUSE_##K2, LABEL_OFFSET(L_FF3_##H##_##T##_##K##_##U##_##K2)},
       PLCFI_FUSED(RULE_P, RULE_F, RULE_P3, RULE_FF3)
+// Rule 20: the jump reads the element as its operand b (JMPF, JMPT: its only one) or c.
+#define RULE_EJ(L, N, J)                                                    \
+  {Op::L##N, Op::J, Op::Count_, FUSE_B, 0, LABEL_OFFSET(L_EJ_##L##N##_##J)}, \
+      {Op::L##N, Op::J, Op::Count_, FUSE_C, 0, LABEL_OFFSET(L_EJ_##L##N##_##J)},
+      PLCFI_ELEM_JUMPS(RULE_EJ)
+#undef RULE_EJ
+      // Rule 21: one structure element assigned from another (the STXB stores the block the
+      // LDXB loaded: its operand g).
+      {Op::LDXB, Op::STXB, Op::Count_, 7, 0, LABEL_OFFSET(L_EB_LDXB_STXB)},
 #undef RULE_FF3
 #undef RULE_P
 #undef RULE_F
@@ -1267,6 +1295,38 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); FALL(3);
     TV_##U(K2, NEXT, w)                                                         \
   }
   PLCFI_FUSED(FUSED_P, FUSED_F, FUSED_P3, FUSED_FF3)
+  // Rule 20 (PLCFI_ELEM_JUMPS): the element load as its instruction does it (a refused
+  // index traps at the load), then the jump's own handler, which reads what it stored.
+#define EJ_LOAD_LDX(N, T) ELEM_INDEX(int32_t, 3) W(T, 1, ld<T>(base + pc[2] + i * N)); pc += 6;
+#define EJ_LOAD_LDXN(N, T) W(T, 1, ld<T>(base + pc[2] + (int64_t{R(int32_t, 3)} - static_cast<int32_t>(pc[4])) * N)); pc += 6;
+#define EJ_LOAD_LDXS(N, T) ELEM_INDEX(int32_t, 3) W(T, 1, ld<T>(base + pc[2] + i * pc[6] + pc[7])); pc += 8;
+#define EJ_LOAD_LDXSN(N, T)                                                                                \
+  W(T, 1, ld<T>(base + pc[2] + (int64_t{R(int32_t, 3)} - static_cast<int32_t>(pc[4])) * pc[6] + pc[7])); \
+  pc += 8;
+#define EJ_LOAD_LDXR(N, T) \
+  W(T, 1, ld<T>(base + (int64_t{R(int32_t, 2)} + int64_t{R(int32_t, 3)} * static_cast<int32_t>(pc[4])))); pc += 7;
+#define EJ_T1 uint8_t
+#define EJ_T2 uint16_t
+#define EJ_T4 uint32_t
+#define FUSED_EJ(L, N, J) L_EJ_##L##N##_##J: { EJ_LOAD_##L(N, EJ_T##N) goto L_##J; }
+  PLCFI_ELEM_JUMPS(FUSED_EJ)
+#undef FUSED_EJ
+#undef EJ_LOAD_LDX
+#undef EJ_LOAD_LDXN
+#undef EJ_LOAD_LDXS
+#undef EJ_LOAD_LDXSN
+#undef EJ_LOAD_LDXR
+#undef EJ_T1
+#undef EJ_T2
+#undef EJ_T4
+  // Rule 21: items[j] := items[j - 1], a structure (or FB instance) element assigned from
+  // another: the LDXB into a temporary as it does it, then the STXB's own handler.
+L_EB_LDXB_STXB: {
+  ELEM_INDEX_AS(i, int32_t, 3)
+  move_block(base + pc[1], base + pc[2] + i * pc[6] + pc[7], pc[8]);
+  pc += 9;
+  goto L_STXB;
+}
   // A reduction loop as a whole (find_reductions, run_reduction).
 L_REDUCE: {
   const auto head = static_cast<uint32_t>(pc - code);
@@ -1287,6 +1347,9 @@ L_REDUCE: {
 
 #undef LABEL_OFFSET
 #undef PLCFI_FUSED
+#undef PLCFI_ELEM_JUMPS
+#undef PLCFI_ELEM_JUMPS_OF
+#undef PLCFI_ELEM_CMP
 #undef DISPATCH
 #undef NEXT
 #undef R

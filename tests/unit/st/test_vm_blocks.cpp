@@ -186,5 +186,47 @@ TEST(VmBlocks, ElementToElementCopiesAgreeWithTheNativeTier) {
   });
 }
 
+// Rule 21: the interpreter runs an element-to-element copy (LDXB into a temporary, STXB
+// from it) as one handler. The copies above are fused; an index refused on either side
+// traps at the same instruction, with the same message, as the plain pair.
+TEST(VmBlocks, ElementToElementCopiesAreOneHandlerInTheInterpreter) {
+  auto fused = [](const std::string& src) {
+    vmtest::VmRun p(src, {}, "blocks.st");
+    if (!p.ok()) return size_t{0};
+    p.scan();
+    size_t n = 0;
+    for (const auto& [pc, name] : p.m->superinstructions()) n += name == "LDXB+STXB";
+    return n;
+  };
+  EXPECT_EQ(3u, fused(kElementCopies));
+  // The source runs out first (s = 6 on the fourth scan), or the destination (d = 5 on
+  // the third).
+  for (const char* steps : {"ds : DINT := 2; dd : DINT := 1;", "ds : DINT := 1; dd : DINT := 2;"}) {
+    const std::string refused = std::string(R"(TYPE
+  Item : STRUCT id : DINT; key : INT; END_STRUCT;
+END_TYPE
+PROGRAM P
+VAR a : ARRAY [0..4] OF Item; s : DINT; d : DINT := 1; n : DINT; )") + steps + R"( END_VAR
+a[0].id := n + 10; a[0].key := DINT_TO_INT(n * 3);
+a[d] := a[s];
+s := s + ds; d := d + dd; n := n + 1;
+END_PROGRAM
+)";
+    EXPECT_EQ(1u, fused(refused));
+    same_in_both_tiers("blocks.st", refused, 5);
+    vmtest::VmRun p(refused, {}, "blocks.st");
+    ASSERT_TRUE(p.ok());
+    const bool source_first = steps[13] == '2';
+    const int good = source_first ? 3 : 2;
+    for (int k = 0; k < good; ++k) ASSERT_TRUE(p.scan()) << k;
+    EXPECT_EQ(p.get("P.a[1].id"), 10);  // a[1] := a[0] on the first scan
+    EXPECT_EQ(p.get("P.a[1].key"), 0);
+    EXPECT_FALSE(p.scan());
+    EXPECT_EQ(p.m->trap().kind, TrapKind::IndexOutOfRange);
+    EXPECT_EQ(p.m->trap().loc.line, 7u);
+    EXPECT_NE(p.m->trap().message.find(source_first ? "6" : "5"), std::string::npos) << p.m->trap().message;
+  }
+}
+
 }  // namespace
 }  // namespace plcfi::st
