@@ -183,13 +183,20 @@ class Machine {
   // handler's offset, or a superinstruction's when the instruction and the next (and the
   // one after, for a triple) fit one of `rules` (operand: 0, or the word of the second
   // instruction that must name the slot the first writes: 2 = its operand b, 3 = c).
+  // A rule that yields applies only where the second instruction heads no rule that does
+  // not yield (a pair of its own is worth more than being the tail of this one).
   struct FusedRule {
     Op head, tail, third;  // third: Op::Count_ for a pair
     uint32_t operand, operand2;  // operand2: the same for the third and the second
     int32_t offset;
+    bool yields = false;
   };
   void thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules,
                    int32_t reduction);
+  // The first of `rules` that fits the instruction at `at` and those after it, those that
+  // yield only if `yielding`; null when none does. heads[op]: some rule starts with op.
+  static const FusedRule* first_fit(const std::vector<uint32_t>& code, const std::vector<uint8_t>& heads,
+                                    const FusedRule* rules, size_t n_rules, uint32_t at, bool yielding);
   // A reduction loop (see find_reductions): a FOR loop whose body accumulates one or two
   // elements indexed by its counter, `s := s + a[i]` or `s := s + a[i] * b[i]` (DINT or
   // REAL), run as a whole by one handler. Decoded from the code when it is threaded.

@@ -25,8 +25,9 @@ inline ::testing::AssertionResult same_memory(const Application& app, const Mach
 // memory and coverage after every scan. budget 0: the machines' default watchdog.
 // `inputs`, when given, writes the same inputs into both machines before each scan.
 inline void same_in_both_tiers(const std::string& file, const std::string& src, int scans, uint64_t budget = 0,
-                               const std::function<void(Machine&, int)>& inputs = nullptr) {
-  auto b = build_sources({{file, src}}, CompileOptions{});
+                               const std::function<void(Machine&, int)>& inputs = nullptr,
+                               const CompileOptions& options = {}) {
+  auto b = build_sources({{file, src}}, options);
   ASSERT_TRUE(b->ok()) << b->diags.render_all();
   std::string err;
   auto native = NativeCode::build(*b->app, NativeOptions{}, &err);

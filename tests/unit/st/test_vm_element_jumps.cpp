@@ -1,8 +1,9 @@
-// Rule 20: a conditional jump on an array element (IF f[i] THEN, IF r[j - 1].key > x THEN,
-// WHILE a[k] <> 0 DO) runs as one handler in the interpreter: the element load and the
-// jump that reads what it loaded. Each case runs the interpreter against the native tier,
-// which has no superinstructions (memory, coverage and traps after every scan), checks
-// values by hand, and that the fused handlers were really used.
+// Rules 20 and 22: an array element loaded for the instruction after it, a conditional
+// jump (IF f[i] THEN, IF r[j - 1].key > x THEN, WHILE a[k] <> 0 DO) or a widening
+// conversion (INT_TO_DINT(a[i])), runs as one handler in the interpreter with that
+// instruction. Each case runs the interpreter against the native tier, which has no
+// superinstructions (memory, coverage and traps after every scan; with coverage marks
+// and without), checks values by hand, and that the fused handlers were really used.
 #include <gtest/gtest.h>
 
 #include <set>
@@ -14,9 +15,24 @@
 namespace plcfi::st {
 namespace {
 
-// The names of the superinstructions the interpreter runs on `src` (after one scan).
+// Compiled as `plcfi run` compiles without --coverage: no COV after a jump (a jump and
+// the COV after it are a superinstruction of their own, to which these rules yield).
+CompileOptions no_coverage() {
+  CompileOptions o;
+  o.coverage = false;
+  return o;
+}
+
+// Both tiers, scan by scan, compiled with coverage marks and without.
+void same_in_both_tiers(const std::string& file, const std::string& src, int scans, uint64_t budget = 0) {
+  plcfi::st::same_in_both_tiers(file, src, scans, budget);
+  plcfi::st::same_in_both_tiers(file, src, scans, budget, nullptr, no_coverage());
+}
+
+// The names of the superinstructions the interpreter runs on `src` (after one scan),
+// compiled without coverage marks.
 std::set<std::string> fused_names(const std::string& src) {
-  vmtest::VmRun p(src, {}, "ejump.st");
+  vmtest::VmRun p(src, no_coverage(), "ejump.st");
   if (!p.ok()) return {};
   p.scan();
   std::set<std::string> out;
@@ -149,7 +165,7 @@ END_WHILE;
 len := k;
 END_PROGRAM
 )",
-                  {}, "ejump.st");
+                  no_coverage(), "ejump.st");
   ASSERT_TRUE(p.ok());
   ASSERT_TRUE(p.scan());
   EXPECT_EQ(p.get("P.set"), 126);
@@ -218,12 +234,12 @@ END_PROGRAM
   EXPECT_EQ(q.get("P.n"), 8);
 }
 
-// The fused handler applies only when the jump reads the slot the load wrote: a jump on
-// another value after an element load stays two instructions and means the same.
-TEST(VmElementJumps, OnlyWhenTheJumpReadsTheElement) {
+// The pair is fused whichever operands the jump reads: after an element load, a jump on
+// another value of the element's width means what it meant.
+TEST(VmElementJumps, AJumpOnAnotherValueMeansTheSame) {
   const std::string src = R"(
 PROGRAM P
-VAR a : ARRAY [0..3] OF INT := [3, 1, 4, 1]; i : DINT; b : BOOL; n : DINT; t : INT; END_VAR
+VAR a : ARRAY [0..3] OF BYTE := [3, 1, 4, 1]; i : DINT; b : BOOL; n : DINT; t : BYTE; END_VAR
 FOR i := 0 TO 3 DO
   t := a[i];
   IF b THEN n := n + 1; END_IF;
@@ -232,7 +248,143 @@ END_FOR;
 END_PROGRAM
 )";
   same_in_both_tiers("ejump.st", src, 3);
-  for (const auto& name : fused_names(src)) EXPECT_EQ(name.find("LDXN2+J"), std::string::npos) << name;
+  EXPECT_EQ(fused_names(src).count("LDXN1+JMPF"), 1u);
+}
+
+// Rule 22: an element loaded for a widening conversion. Each expression reads an element
+// (every access form) for a conversion, an arithmetic or a bitwise operation; the results
+// are folded into `acc`, compared with the native tier's.
+std::string uses_program() {
+  struct Use {
+    const char* type;   // the element's type
+    const char* expr;   // @: the element
+    const char* into;   // the variable it is assigned to
+  };
+  const Use uses[] = {
+      {"BOOL", "@ AND fb", "xb"},         {"BOOL", "@ OR fb", "xb"},          {"BOOL", "@ XOR fb", "xb"},
+      {"BYTE", "@ AND yb", "xy"},         {"BYTE", "@ OR yb", "xy"},          {"BYTE", "@ XOR yb", "xy"},
+      {"BYTE", "BYTE_TO_WORD(@)", "xw"},  {"BYTE", "BYTE_TO_DWORD(@)", "xd"}, {"USINT", "USINT_TO_INT(@)", "xi"},
+      {"USINT", "USINT_TO_DINT(@)", "xj"}, {"SINT", "SINT_TO_INT(@)", "xi"},  {"SINT", "SINT_TO_DINT(@)", "xj"},
+      {"INT", "@ + yi", "xi"},            {"INT", "@ - yi", "xi"},            {"INT", "@ * yi", "xi"},
+      {"WORD", "@ AND yw", "xw"},         {"WORD", "@ OR yw", "xw"},          {"WORD", "@ XOR yw", "xw"},
+      {"INT", "INT_TO_DINT(@)", "xj"},    {"WORD", "WORD_TO_DWORD(@)", "xd"}, {"UINT", "UINT_TO_DINT(@)", "xj"},
+      {"DINT", "@ + yj", "xj"},           {"DINT", "@ - yj", "xj"},           {"DINT", "@ * yj", "xj"},
+      {"DINT", "@ * yj + zj", "xj"},      {"DWORD", "@ AND yd", "xd"},        {"DWORD", "@ OR yd", "xd"},
+      {"DWORD", "@ XOR yd", "xd"},        {"REAL", "@ + yr", "xr"},           {"REAL", "@ - yr", "xr"},
+      {"REAL", "@ * yr", "xr"},           {"DINT", "DINT_TO_REAL(@)", "xr"},
+  };
+  std::string vars, fill, body;
+  std::set<std::string> declared;
+  int u = 0;
+  for (const Use& use : uses) {
+    const std::string T = use.type, n = std::to_string(u++);
+    if (declared.insert(T).second) {
+      vars += "  a_" + T + " : ARRAY [0..7] OF " + T + ";\n  s_" + T + " : ARRAY [0..7] OF S_" + T + ";\n";
+      vars += "  l_" + T + " : ARRAY [0..15] OF " + T + ";\n  m_" + T + " : ARRAY [1..2, 0..3] OF " + T + ";\n";
+      const std::string conv = T == "BOOL"   ? "((v MOD 3) = 0)"
+                               : T == "REAL" ? "DINT_TO_REAL(v - 100) * 0.37"
+                               : T == "DINT" ? "(v - 100) * 40000"
+                                             : "DINT_TO_" + T + "(v - 100)";
+      fill += "  FOR i := 0 TO 7 DO v := (i * 37 + scan * 11) MOD 256; a_" + T + "[i] := " + conv + "; v := v + 5; s_" + T +
+              "[i].v := " + conv + "; END_FOR;\n";
+      fill += "  FOR i := 0 TO 15 DO v := (i * 53 + scan * 7) MOD 256; l_" + T + "[i] := " + conv + "; END_FOR;\n";
+      fill += "  FOR i := 1 TO 2 DO FOR j := 0 TO 3 DO v := (i * 29 + j * 61 + scan * 13) MOD 256; m_" + T + "[i, j] := " +
+              conv + "; END_FOR; END_FOR;\n";
+    }
+    auto stmt = [&](const std::string& elem) {
+      std::string e = use.expr;
+      e.replace(e.find('@'), 1, elem);
+      return std::string(use.into) + " := " + e + "; fold(" + use.into + ", " + n + ");";
+    };
+    body += "  " + stmt("a_" + T + "[k]") + "\n";
+    body += "  FOR i := 0 TO 7 DO " + stmt("a_" + T + "[i]") + " END_FOR;\n";
+    body += "  " + stmt("s_" + T + "[k].v") + "\n";
+    body += "  FOR i := 0 TO 7 DO " + stmt("s_" + T + "[i].v") + " END_FOR;\n";
+    body += "  FOR i := 0 TO 3 DO FOR j := 0 TO hi DO " + stmt("l_" + T + "[i * 4 + j]") + " END_FOR; END_FOR;\n";
+    body += "  FOR i := 1 TO 2 DO FOR j := 0 TO 3 DO " + stmt("m_" + T + "[i, j]") + " END_FOR; END_FOR;\n";
+  }
+  // fold(x, n): a statement that keeps every use apart (no reduction loop) and sums it.
+  std::string folded;
+  for (const char* x : {"xb", "xy", "xw", "xd", "xi", "xj", "xr"}) {
+    const std::string X = x;
+    const std::string as_dint = X == "xb"   ? "BOOL_TO_DINT(xb)"
+                                : X == "xr" ? "REAL_TO_DINT(xr * 8.0)"
+                                : X == "xj" ? "xj"
+                                : X == "xy" ? "BYTE_TO_DINT(xy)"
+                                : X == "xw" ? "WORD_TO_DINT(xw)"
+                                : X == "xd" ? "DWORD_TO_DINT(xd)"
+                                            : "INT_TO_DINT(xi)";
+    folded += X + ":" + as_dint + ";";
+  }
+  // Replace each fold(x, n) by an accumulation in DINT with a per-use weight.
+  std::string out;
+  for (size_t at = 0;;) {
+    const size_t f = body.find("fold(", at);
+    if (f == std::string::npos) {
+      out += body.substr(at);
+      break;
+    }
+    const size_t comma = body.find(", ", f), close = body.find(')', comma);
+    const std::string x = body.substr(f + 5, comma - f - 5), w = body.substr(comma + 2, close - comma - 2);
+    const size_t def = folded.find(x + ":");
+    const std::string as_dint = folded.substr(def + x.size() + 1, folded.find(';', def) - def - x.size() - 1);
+    out += body.substr(at, f - at) + "acc := acc * 3 + " + as_dint + " + " + w;
+    at = close + 1;
+  }
+  std::string types = "TYPE\n";
+  for (const auto& T : declared) types += "  S_" + T + " : STRUCT pad : BYTE; v : " + T + "; END_STRUCT;\n";
+  types += "END_TYPE\n";
+  return types + "PROGRAM P\nVAR\n" + vars +
+         "  i : DINT; j : DINT; k : DINT; v : DINT; hi : DINT := 3; scan : DINT; acc : DINT;\n"
+         "  fb : BOOL; yb : BYTE := 16#5A; yw : WORD := 16#0FF0; yd : DWORD := 16#00FF00FF; yi : INT := -7;\n"
+         "  yj : DINT := 12345; zj : DINT := -99; yr : REAL := 1.5;\n"
+         "  xb : BOOL; xy : BYTE; xw : WORD; xd : DWORD; xi : INT; xj : DINT; xr : REAL;\nEND_VAR\n" +
+         fill + "  k := scan MOD 8;\n  fb := (scan MOD 2) = 0;\n" + out + "  scan := scan + 1;\nEND_PROGRAM\n";
+}
+
+TEST(VmElementUses, ConversionsAndArithmeticOnElementsAgreeWithTheNativeTier) {
+  const std::string src = uses_program();
+  same_in_both_tiers("euse.st", src, 6);
+  const auto names = fused_names(src);
+  // Widening conversions of an element, in every access form.
+  for (const char* form : {"LDX", "LDXN", "LDXS", "LDXSN", "LDXL", "LDXR"}) {
+    const std::string f = form;
+    for (const std::string& name : {f + "1+CVT_U8_U16", f + "1+CVT_U8_U32", f + "1+CVT_U8_I16", f + "1+CVT_U8_I32",
+                                    f + "1+CVT_I8_I16", f + "1+CVT_I8_I32", f + "2+CVT_I16_I32", f + "2+CVT_U16_U32",
+                                    f + "2+CVT_U16_I32"})
+      EXPECT_EQ(names.count(name), 1u) << name;
+    // Arithmetic, bitwise operations and REAL conversions are left as they are (the rule's
+    // list leaves them out).
+    for (const std::string& name : {f + "1+BXOR", f + "2+MUL_I16", f + "4+XOR_U32", f + "4+ADD_F32", f + "4+CVT_I32_F32"})
+      EXPECT_EQ(names.count(name), 0u) << name;
+  }
+}
+
+// The rule yields: an element loaded for a CVT_I16_I32 that heads a superinstruction of
+// its own (CVT_I16_I32+MADD_I32, INT_TO_DINT(a[i]) * k + s) is left to that one.
+TEST(VmElementUses, YieldsToTheNextInstructionsOwnSuperinstruction) {
+  const std::string src = R"(
+PROGRAM P
+VAR a : ARRAY [0..7] OF INT := [1, -2, 3, -4, 5, -6, 7, -8]; i : DINT; k : DINT := 31; s : DINT; t : DINT; u : DINT; END_VAR
+FOR i := 0 TO 7 DO
+  s := INT_TO_DINT(a[i]) * k + s;
+  t := t + 1;
+  u := INT_TO_DINT(a[i]) + u;
+END_FOR;
+END_PROGRAM
+)";
+  same_in_both_tiers("euse.st", src, 3);
+  const auto names = fused_names(src);
+  EXPECT_EQ(names.count("CVT_I16_I32+MADD_I32"), 1u);
+  EXPECT_EQ(names.count("LDXN2+CVT_I16_I32"), 1u);  // the second: INT_TO_DINT(a[i]) + u
+  vmtest::VmRun p(src, no_coverage(), "euse.st");
+  ASSERT_TRUE(p.ok());
+  ASSERT_TRUE(p.scan());
+  EXPECT_EQ(p.get("P.s"), 31 * (1 - 2 + 3 - 4 + 5 - 6 + 7 - 8));
+  EXPECT_EQ(p.get("P.u"), -4);
+  size_t fused_cvt = 0;
+  for (const auto& [pc, name] : p.m->superinstructions()) fused_cvt += name == "LDXN2+CVT_I16_I32";
+  EXPECT_EQ(fused_cvt, 1u);
 }
 
 }  // namespace
