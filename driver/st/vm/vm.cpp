@@ -679,6 +679,21 @@ ReductionExit run_reduction(const Machine::Reduction& r, uint8_t* base, int64_t&
 }  // namespace
 
 bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_io) {
+  if (exec_.size() != app_->code.size()) [[unlikely]] {
+    // Which build of run_impl runs this code (the one that threads it, too).
+    const std::vector<uint32_t>& code = app_->code;
+    code_has_cov_ = false;
+    for (uint32_t pc = 0, len = 0; pc < code.size() && !code_has_cov_; pc += len) {
+      len = instruction_length(code, pc);
+      if (len == 0) break;
+      code_has_cov_ = code[pc] == static_cast<uint32_t>(Op::COV);
+    }
+  }
+  return code_has_cov_ ? run_impl<true>(entry, base, mtop, budget_io) : run_impl<false>(entry, base, mtop, budget_io);
+}
+
+template <bool Coverage>
+bool Machine::run_impl(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_io) {
   // Handler addresses as offsets from the first handler, one per opcode.
 #define LABEL_OFFSET(l) static_cast<int32_t>(reinterpret_cast<intptr_t>(&&l) - reinterpret_cast<intptr_t>(&&L_NOP))
   static const int32_t kOffsets[] = {
@@ -747,9 +762,10 @@ bool Machine::run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget_
   // CASE table leads (taken or not) is done there and skipped, which spares every arm a
   // dispatch. The same bit is set as by the COV itself.
   // (A COV that heads a superinstruction is left to it.) The word is compared with the
-  // static table's, which keeps no further pointer live across the handlers.
-#define COVER(p)                                                                     \
-  if (*(p) == static_cast<uint32_t>(kOffsets[static_cast<uint32_t>(Op::COV)])) {     \
+  // static table's, which keeps no further pointer live across the handlers. Code without
+  // a COV runs in the build without Coverage, whose jumps leave the test out.
+#define COVER(p)                                                                                   \
+  if (Coverage && *(p) == static_cast<uint32_t>(kOffsets[static_cast<uint32_t>(Op::COV)])) {     \
     taken[(p)[1] >> 6] |= uint64_t(1) << ((p)[1] & 63);           \
     (p) += 2;                                                     \
   }

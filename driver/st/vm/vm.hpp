@@ -179,6 +179,11 @@ class Machine {
   // Interprets from pc until the matching RET. mtop: the method stack top; budget: the
   // backward jumps left (read and, on a normal return, written back).
   bool run(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget);
+  // run() itself, in two builds: with Coverage, a jump into an arm marks the arm's COV as
+  // it passes it; without, for code that holds no COV (compiled without coverage), the
+  // jumps do not look for one.
+  template <bool Coverage>
+  bool run_impl(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* budget);
   // Builds exec_ from the application's code (see run()): each opcode word becomes its
   // handler's offset, or a superinstruction's when the instruction and the next (and the
   // one after, for a triple) fit one of `rules` (operand: 0, or the word of the second
@@ -235,6 +240,7 @@ class Machine {
   // the first call: the application's code must not change while the machine is used
   // (mutation analysis patches it before it makes the machines that run the mutant).
   std::vector<uint32_t> exec_;
+  bool code_has_cov_ = false;  // the application's code holds a COV (set when exec_ is built)
   std::vector<std::pair<uint32_t, const FusedRule*>> fused_;  // the heads rewritten in exec_
   std::vector<Reduction> reductions_;  // by head, ascending; their heads rewritten in exec_
   std::vector<uint8_t> mem_;
