@@ -6,6 +6,7 @@
 // and without), checks values by hand, and that the fused handlers were really used.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <set>
 #include <string>
 
@@ -66,43 +67,32 @@ std::string comparisons_program() {
     vars += "  x_" + T + " : " + T + ";\n";
     // Fill with values around x (the bit patterns cover the sign of the signed types).
     fill += "  FOR i := 0 TO 7 DO\n";
-    fill += "    a_" + T + "[i] := TO_" + T + "(DINT_TO_BYTE((i * 37 + scan * 11) MOD 256));\n";
-    fill += "    s_" + T + "[i].v := TO_" + T + "(DINT_TO_BYTE((i * 53 + scan * 7) MOD 256));\n";
+    fill += "    a_" + T + "[i] := " + to + "(i * 37 + scan * 11) MOD 256 - 128);\n";
+    fill += "    s_" + T + "[i].v := " + to + "(i * 53 + scan * 7) MOD 256 - 128);\n";
     fill += "  END_FOR;\n";
     fill += "  FOR i := 1 TO 2 DO FOR j := 0 TO 3 DO m_" + T + "[i, j] := " + to +
             "(i * 29 + j * 61 + scan * 13) MOD 256 - 128); END_FOR; END_FOR;\n";
     fill += "  x_" + T + " := " + to + "(scan * 41 + 100) MOD 256 - 128);\n";
-    for (const char* op : ops) {
-      for (int order = 0; order < 2; ++order) {
-        auto cond = [&](const std::string& e) {
-          return order == 0 ? e + " " + op + " x_" + T : "x_" + T + " " + op + " " + e;
-        };
-        const std::string w = std::to_string(weight);
-        body += "  IF " + cond("a_" + T + "[k]") + " THEN hits := hits + " + w + "; END_IF;\n";
-        body += "  FOR i := 0 TO 7 DO IF " + cond("a_" + T + "[i]") + " THEN hits := hits + " + w + "; END_IF; END_FOR;\n";
-        body += "  IF " + cond("s_" + T + "[k].v") + " THEN hits := hits + " + w + "; END_IF;\n";
-        body += "  FOR i := 0 TO 7 DO IF " + cond("s_" + T + "[i].v") + " THEN hits := hits + " + w + "; END_IF; END_FOR;\n";
-        body += "  FOR i := 1 TO 2 DO FOR j := 0 TO 3 DO IF " + cond("m_" + T + "[i, j]") + " THEN hits := hits + " + w +
-                "; END_IF; END_FOR; END_FOR;\n";
-        weight = weight * 3 % 1000 + 1;
-      }
-    }
+    // One condition on an element of each access form, each adding weight w when it holds.
+    auto add_conditions = [&](const std::function<std::string(const std::string&)>& cond) {
+      const std::string w = std::to_string(weight);
+      const std::string then = " THEN hits := hits + " + w + "; END_IF;";
+      body += "  IF " + cond("a_" + T + "[k]") + then + "\n";
+      body += "  FOR i := 0 TO 7 DO IF " + cond("a_" + T + "[i]") + then + " END_FOR;\n";
+      body += "  IF " + cond("s_" + T + "[k].v") + then + "\n";
+      body += "  FOR i := 0 TO 7 DO IF " + cond("s_" + T + "[i].v") + then + " END_FOR;\n";
+      body += "  FOR i := 1 TO 2 DO FOR j := 0 TO 3 DO IF " + cond("m_" + T + "[i, j]") + then + " END_FOR; END_FOR;\n";
+      weight = weight * 3 % 1000 + 1;
+    };
+    for (const char* op : ops)
+      for (int order = 0; order < 2; ++order)
+        add_conditions([&](const std::string& e) { return order == 0 ? e + " " + op + " x_" + T : "x_" + T + " " + op + " " + e; });
     // Tests of bits: (e AND m) <> 0 and (e AND m) = 0 (JTZ, JTNZ).
-    for (const char* rel : {"<> 0", "= 0"}) {
-      for (int order = 0; order < 2; ++order) {
-        auto cond = [&](const std::string& e) {
+    for (const char* rel : {"<> 0", "= 0"})
+      for (int order = 0; order < 2; ++order)
+        add_conditions([&](const std::string& e) {
           return std::string("(") + (order == 0 ? e + " AND x_" + T : "x_" + T + " AND " + e) + ") " + rel;
-        };
-        const std::string w = std::to_string(weight);
-        body += "  IF " + cond("a_" + T + "[k]") + " THEN hits := hits + " + w + "; END_IF;\n";
-        body += "  FOR i := 0 TO 7 DO IF " + cond("a_" + T + "[i]") + " THEN hits := hits + " + w + "; END_IF; END_FOR;\n";
-        body += "  IF " + cond("s_" + T + "[k].v") + " THEN hits := hits + " + w + "; END_IF;\n";
-        body += "  FOR i := 0 TO 7 DO IF " + cond("s_" + T + "[i].v") + " THEN hits := hits + " + w + "; END_IF; END_FOR;\n";
-        body += "  FOR i := 1 TO 2 DO FOR j := 0 TO 3 DO IF " + cond("m_" + T + "[i, j]") + " THEN hits := hits + " + w +
-                "; END_IF; END_FOR; END_FOR;\n";
-        weight = weight * 3 % 1000 + 1;
-      }
-    }
+        });
   }
   tdecl += "  S_BOOL : STRUCT pad : BYTE; v : BOOL; END_STRUCT;\nEND_TYPE\n";
   vars += "  f : ARRAY [0..7] OF BOOL;\n  sf : ARRAY [0..7] OF S_BOOL;\n  mf : ARRAY [1..2, 0..3] OF BOOL;\n";
