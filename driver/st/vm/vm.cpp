@@ -1356,12 +1356,20 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); FALL(3);
 #undef EU_T2
 #undef EU_T4
   // Rule 21: items[j] := items[j - 1], a structure (or FB instance) element assigned from
-  // another: the LDXB into a temporary as it does it, then the STXB's own handler.
+  // another: the LDXB into a temporary as it does it, then the STXB's store, with its own
+  // index check, from the source element itself. The temporary holds the same bytes, but
+  // reading back a block just stored in overlapping pieces (12 bytes as two 8-byte moves)
+  // stalls the load until the stores are done, in every pass of an insertion sort.
 L_EB_LDXB_STXB: {
   ELEM_INDEX_AS(i, int32_t, 3)
-  move_block(base + pc[1], base + pc[2] + i * pc[6] + pc[7], pc[8]);
+  const uint8_t* const from = base + pc[2] + i * pc[6] + pc[7];
+  const uint32_t size = pc[8];
+  move_block(base + pc[1], from, size);
   pc += 9;
-  goto L_STXB;
+  if (pc[8] != size) goto L_STXB;  // not the block the LDXB loaded: the plain STXB
+  ELEM_INDEX_AS(j, int32_t, 2)
+  move_block(base + pc[1] + j * pc[5] + pc[6], from, size);
+  NEXT(8);
 }
   // A reduction loop as a whole (find_reductions, run_reduction).
 L_REDUCE: {
