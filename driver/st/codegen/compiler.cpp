@@ -152,6 +152,7 @@ static void drop_finished_tables(Body& b) {
   drop(b.lines);
   drop(b.index_shifts);
   drop(b.label_pos);
+  drop(b.label_refs);
   drop(b.target_fix);
   drop(b.slot_fix);
   drop(b.entry_fix);
@@ -201,7 +202,10 @@ void Compiler::emit_list(Op op, const std::vector<Arg>& args) {
       case Arg::K::Slot:
         if (a.sk != SK::Var) b_->slot_fix.emplace_back(static_cast<uint32_t>(code.size()), a.sk);
         break;
-      case Arg::K::Target: b_->target_fix.emplace_back(static_cast<uint32_t>(code.size()), a.v); break;
+      case Arg::K::Target:
+        b_->target_fix.emplace_back(static_cast<uint32_t>(code.size()), a.v);
+        if (a.v < b_->label_refs.size()) ++b_->label_refs[a.v];
+        break;
       case Arg::K::Entry: b_->entry_fix.push_back({static_cast<uint32_t>(code.size()), a.pou, static_cast<EntryKind>(a.v)}); break;
     }
     code.push_back(a.k == Arg::K::Slot || a.k == Arg::K::Imm ? a.v : 0);
@@ -210,12 +214,18 @@ void Compiler::emit_list(Op op, const std::vector<Arg>& args) {
 
 Label Compiler::new_label() {
   b_->label_pos.push_back(UINT32_MAX);
+  b_->label_refs.push_back(0);
   return Label{static_cast<uint32_t>(b_->label_pos.size() - 1)};
 }
 
 void Compiler::bind(Label l) {
   b_->label_pos[l.id] = static_cast<uint32_t>(b_->code.size());
   b_->last_label_pos = static_cast<uint32_t>(b_->code.size());
+}
+
+void Compiler::bind_forward(Label l) {
+  if (b_->label_refs[l.id] != 0) bind(l);
+  else b_->label_pos[l.id] = static_cast<uint32_t>(b_->code.size());
 }
 
 void Compiler::mark(SourceLoc loc) {

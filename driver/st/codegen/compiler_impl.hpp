@@ -152,6 +152,7 @@ struct Body {
   std::vector<uint32_t> code;
   std::vector<std::pair<uint32_t, SourceLoc>> lines;
   std::vector<uint32_t> label_pos;                         // label id -> body-relative pc
+  std::vector<uint32_t> label_refs;                        // label id -> jumps emitted to it
   std::vector<std::pair<uint32_t, uint32_t>> target_fix;   // (code index, label id)
   std::vector<std::pair<uint32_t, SK>> slot_fix;           // (code index, kind) for Temp/Const
   std::vector<EntryFix> entry_fix;
@@ -294,6 +295,10 @@ class Compiler {
   Val expr_for(const Expr& e, const Type* target);
   Label new_label();
   void bind(Label l);
+  // Binds a label that only jumps emitted before it can reach (an IF's end, a WHILE's
+  // CONTINUE target). With none, its position is no jump target: what the code before
+  // it did stays known to the code after it (the peepholes that look back).
+  void bind_forward(Label l);
   void mark(SourceLoc loc);
   Slot temp(uint32_t size, uint32_t align = 8);
   Slot temp_for(const Type* t) { return temp(t->size ? t->size : 1, t->align < 8 ? t->align : 8); }

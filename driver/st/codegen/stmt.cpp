@@ -101,6 +101,14 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
     emit(when_true ? Op::JMPT : Op::JMPF, {Arg::target(target.id), cs});
     return;
   }
+  // A jump on a BOOL variable that the instruction just before set to a constant, with no
+  // jump target between (`moving := FALSE;` at the end of a loop body's arm, followed by
+  // the loop's own test, rule 17): when the constant says it is not taken, it is left out.
+  // (Taken, it stays: a jump back counts against the watchdog.)
+  if (!c.is_const && code[at] == static_cast<uint32_t>(Op::MOV1) && at + 3 == code.size() && b_->last_label_pos <= at &&
+      cs.kind == SK::Var && kind_at(at + 1) == SK::Var && code[at + 1] == cs.off) {
+    if (const auto k = const_at(at + 2, 1); k && (*k != 0) != when_true) return;
+  }
   if (!c.is_const && b_->last_def_pos == at && b_->last_label_pos <= at && code[at] == static_cast<uint32_t>(Op::BNOT) &&
       b_->last_def.kind == cs.kind && b_->last_def.off == cs.off && cs.kind == SK::Temp) {
     // "BNOT t, x; JMPF target, t" -> "JMPT target, x".
@@ -510,7 +518,7 @@ void Compiler::if_stmt(const IfStmt& s) {
     ArmScope in(b_, branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE", s.loc, &decision, *s.else_body));
     stmts(*s.else_body);
   }
-  bind(end);
+  bind_forward(end);
 }
 
 void Compiler::case_stmt(const CaseStmt& s) {
@@ -1100,7 +1108,7 @@ void Compiler::while_stmt(const WhileStmt& s) {
     loop_tail_ = nullptr;
     b_->loops.pop_back();
   }
-  bind(test);
+  bind_forward(test);
   bottom_test(*s.cond, body, true);
   bind(exit);
 }

@@ -5,7 +5,10 @@
 // tiers; the watchdog must count the copied back edges as it counts the original.
 #include <gtest/gtest.h>
 
+#include <cctype>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "engine.hpp"
 #include "same_memory.hpp"
@@ -126,12 +129,14 @@ TEST(VmTails, ArmsEndingALoopBodyRunTheLoopsBottomAndComputeTheSame) {
   const std::string dis = on.disasm(), plain = off.disasm();
   // Copies: the CRC loop's LOOPUP (its THEN arm); the LOOPDN: the IF and both ELSIF
   // arms (the one with EXIT as well), and the THEN arm of the IF that ends the first
-  // ELSIF arm; the WHILE tests (JMPT): the sort's IF and ELSIF arms and the THEN arm of
-  // the loop whose condition calls Probe; the UNTIL test: the three CASE arms (the
-  // ELSE falls to the bottom).
+  // ELSIF arm; the WHILE tests (JMPT): the sort's ELSIF arm and the THEN arm of the loop
+  // whose condition calls Probe; the UNTIL test: the three CASE arms (the ELSE falls to
+  // the bottom). The sort's IF and ELSE arms end with `moving := FALSE`: there the test
+  // of moving, which could not be taken, is left out (rule 23), in the IF arm's copy and
+  // at the bottom, which only the ELSE arm reaches.
   EXPECT_EQ(occurrences(plain, " LOOPUP_I32") + 1, occurrences(dis, " LOOPUP_I32")) << dis;
   EXPECT_EQ(occurrences(plain, " LOOPDN_I32") + 4, occurrences(dis, " LOOPDN_I32")) << dis;
-  EXPECT_EQ(occurrences(plain, " JMPT ") + 3, occurrences(dis, " JMPT ")) << dis;
+  EXPECT_EQ(occurrences(plain, " JMPT ") + 1, occurrences(dis, " JMPT ")) << dis;
   EXPECT_EQ(occurrences(plain, " CALL ") + 1, occurrences(dis, " CALL ")) << dis;  // Probe, in the copy of the test
   EXPECT_GT(occurrences(plain, " JMP "), 0u);
   for (int scan = 0; scan < 8; ++scan) {
@@ -187,6 +192,100 @@ END_PROGRAM
   EXPECT_EQ(TrapKind::Watchdog, on.m->trap().kind);
   EXPECT_EQ(off.m->trap().kind, on.m->trap().kind);
   EXPECT_EQ(off.get("P.k"), on.get("P.k"));
+}
+
+// Rule 23: a conditional jump on a BOOL variable that the instruction just before set to
+// a constant, with no jump target between, is left out when it cannot be taken. Where
+// the flag is set TRUE, where CONTINUE reaches the loop's test, and where an IF's other
+// arms jump to its end, the test stays; every loop computes what it did.
+const char* kFlags = R"(PROGRAM P
+VAR
+  a : ARRAY [0..9] OF INT; tmp : INT;
+  i, j, k, n, m, seed : DINT;
+  moving, done, again : BOOL;
+END_VAR
+FOR i := 0 TO 9 DO seed := (seed * 75 + 74) MOD 65537; a[i] := DINT_TO_INT(seed MOD 100); END_FOR;
+(* insertion sort ended by a flag *)
+FOR i := 1 TO 9 DO
+  tmp := a[i];
+  j := i;
+  moving := TRUE;
+  WHILE moving DO
+    IF j = 0 THEN
+      moving := FALSE;
+    ELSIF a[j - 1] > tmp THEN
+      a[j] := a[j - 1];
+      j := j - 1;
+    ELSE
+      moving := FALSE;
+    END_IF;
+  END_WHILE;
+  a[j] := tmp;
+END_FOR;
+(* a flag set TRUE at the end of a pass: the jump back stays *)
+k := 0;
+again := TRUE;
+WHILE again DO
+  k := k + 1;
+  IF k >= 5 THEN again := FALSE; ELSE again := TRUE; END_IF;
+END_WHILE;
+(* CONTINUE reaches the test with the flag as it was *)
+moving := TRUE;
+n := 0;
+WHILE moving DO
+  n := n + 1;
+  IF n < 3 THEN CONTINUE; END_IF;
+  moving := FALSE;
+END_WHILE;
+(* an IF whose THEN arm jumps to its end, the ELSE arm clearing the flag before the test *)
+done := FALSE;
+m := 0;
+REPEAT
+  m := m + 1;
+  IF m MOD 2 = 0 THEN
+    done := m >= 6;
+  ELSE
+    done := FALSE;
+  END_IF;
+  seed := seed + 1;
+UNTIL done
+END_REPEAT;
+END_PROGRAM
+)";
+
+TEST(VmTails, AJumpOnAFlagJustClearedIsLeftOut) {
+  same_in_both_tiers("tails.st", kFlags, 3);
+  for (bool tails : {true, false}) {
+    Prog p(kFlags, tails);
+    ASSERT_TRUE(p.ok());
+    ASSERT_TRUE(p.scan()) << p.m->trap().message;
+    for (int i = 1; i < 10; ++i) EXPECT_LE(p.get("P.a[" + std::to_string(i - 1) + "]"), p.get("P.a[" + std::to_string(i) + "]"));
+    EXPECT_EQ(p.get("P.k"), 5);
+    EXPECT_EQ(p.get("P.n"), 3);
+    EXPECT_EQ(p.get("P.m"), 6);
+  }
+  // With loop tails, the sort's two `moving := FALSE` arms have no jump on moving after
+  // them; the other loops keep theirs.
+  Prog p(kFlags, true);
+  ASSERT_TRUE(p.ok());
+  const std::string dis = p.disasm();
+  // The listing's instructions, each as its words (address, name, operands).
+  std::vector<std::vector<std::string>> ins;
+  std::istringstream lines(dis);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string x; words >> x;) w.push_back(x);
+    if (w.size() >= 2 && std::isdigit(static_cast<unsigned char>(w[0][0]))) ins.push_back(w);
+  }
+  size_t cleared_then_tested = 0;  // MOV1 v, K followed by JMPT target, v
+  for (size_t i = 0; i + 1 < ins.size(); ++i)
+    if (ins[i][1] == "MOV1" && ins[i + 1][1] == "JMPT" && ins[i].size() == 4 && ins[i + 1].size() == 4 &&
+        ins[i][2] == ins[i + 1][3])
+      ++cleared_then_tested;
+  // The two left: again := TRUE (taken) and moving := FALSE before the test CONTINUE
+  // also reaches.
+  EXPECT_EQ(cleared_then_tested, 2u) << dis;
 }
 
 }  // namespace
