@@ -135,6 +135,7 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   const Campaign& c = out->spec;
   st::CompileOptions opt;
   opt.warnings = false;
+  opt.condition_jumps = !c.whole_conditions;
   st::parse_dialect(c.dialect, &opt.dialect);  // checked when the file was read
 
   // 1. The program alone: bindings, alarms and fault targets are checked against it.

@@ -61,7 +61,8 @@ struct Mutant {
   const st::PouInfo* pou = nullptr;  // the POU whose code or constant is patched
 };
 
-// The mutants of the campaign's program, in a deterministic order (POU code order, then
+// The mutants of the campaign's program (compiled with CompileOptions::condition_jumps
+// off: Campaign::whole_conditions), in a deterministic order (POU code order, then
 // operator). Equivalence proofs are filled in: byte-identical patch, duplicate of an
 // earlier mutant, or code unreachable from every task entry.
 std::vector<Mutant> generate_mutants(const CampaignBuild& cb);

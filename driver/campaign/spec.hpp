@@ -167,6 +167,9 @@ struct Campaign {
   RestartKind restart = RestartKind::Cold;
   std::string io;  // a file with an io: section: the campaign runs on real I/O (needs --arm)
   ExploreSettings explore;
+  // Each IF, WHILE and REPEAT condition compiled as one value and one jump on it, not as a
+  // chain of jumps (CompileOptions::condition_jumps): what mutation analysis patches.
+  bool whole_conditions = false;
   // EDTL requirements (a requirements file) that an explored case must not violate to count
   // as tolerated; "" = none. FMEA cases do not use them.
   std::string requirements;

@@ -37,6 +37,10 @@ struct CompileOptions {
   // (LOOPUP, the WHILE or UNTIL test) instead of a jump to it (see loop_tail_); off, with
   // the jump (tests compare the two).
   bool loop_tails = true;
+  // An IF, WHILE or REPEAT condition that is an AND or OR of terms, whose later terms only
+  // read variables and cannot fail, is a chain of conditional jumps (see cond_branch);
+  // off, one value and one jump on it (mutation analysis patches that jump).
+  bool condition_jumps = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

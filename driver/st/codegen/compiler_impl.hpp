@@ -347,6 +347,19 @@ class Compiler {
   // just computed into a temporary becomes one fused compare-and-jump instruction.
   // (Defined in stmt.cpp.)
   void branch_on(const Val& c, SourceLoc loc, Label target, bool when_true);
+  // Compiles the condition e and jumps to target when it is when_true; what cond() and
+  // branch_on() do, but an AND or OR whose later operands only read variables and cannot
+  // fail is a chain of jumps (the operands after the one that decides are not evaluated,
+  // which nothing can observe). The value: cond()'s, or BOOL and not constant for a chain.
+  Val cond_branch(const Expr& e, Label target, bool when_true);
+  // Whether e is such an AND or OR (with CompileOptions::condition_jumps); its terms in
+  // evaluation order.
+  bool chain_terms(const Expr& e, std::vector<const Expr*>* terms);
+  // The type of e when evaluating it only reads variables and cannot fail (no call,
+  // property, dereference, VAR_IN_OUT or division by a variable; each array index a
+  // constant or the same access as one in `checked`, evaluated before; null `checked`:
+  // any index, e may fail a bounds check), else null.
+  const Type* plain_read_type(const Expr& e, const std::vector<const IndexExpr*>* checked, int depth);
   bool test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero);
   // For the peepholes that read code just emitted: the slot kind of the operand at a code
   // word, and the value of a constant pool slot of `width` bytes there (nullopt: none).

@@ -167,6 +167,226 @@ void Compiler::branch_on(const Val& c, SourceLoc loc, Label target, bool when_tr
 }
 
 namespace {
+bool is_and_or(const Expr& e) {
+  if (e.kind != ExprKind::Binary) return false;
+  const BinaryOp op = static_cast<const BinaryExpr&>(e).op;
+  return op == BinaryOp::And || op == BinaryOp::Or;
+}
+
+// Whether two expressions that plain_read_type accepts are written alike (names compared
+// as IEC compares them, without case).
+bool same_expr(const Expr& a, const Expr& b, int depth) {
+  if (a.kind != b.kind || depth > 64) return false;
+  switch (a.kind) {
+    case ExprKind::Literal: {
+      const auto& x = static_cast<const LiteralExpr&>(a);
+      const auto& y = static_cast<const LiteralExpr&>(b);
+      return x.lit == LiteralKind::Int && y.lit == LiteralKind::Int && x.int_value == y.int_value &&
+             iequals(x.type_prefix, y.type_prefix);
+    }
+    case ExprKind::Name:
+      return iequals(static_cast<const NameExpr&>(a).name.text, static_cast<const NameExpr&>(b).name.text);
+    case ExprKind::Member: {
+      const auto& x = static_cast<const MemberExpr&>(a);
+      const auto& y = static_cast<const MemberExpr&>(b);
+      return iequals(x.member.text, y.member.text) && same_expr(*x.base, *y.base, depth + 1);
+    }
+    case ExprKind::BitAccess: {
+      const auto& x = static_cast<const BitAccessExpr&>(a);
+      const auto& y = static_cast<const BitAccessExpr&>(b);
+      return x.bit == y.bit && same_expr(*x.base, *y.base, depth + 1);
+    }
+    case ExprKind::Index: {
+      const auto& x = static_cast<const IndexExpr&>(a);
+      const auto& y = static_cast<const IndexExpr&>(b);
+      if (x.indices.size() != y.indices.size() || !same_expr(*x.base, *y.base, depth + 1)) return false;
+      for (size_t i = 0; i < x.indices.size(); ++i)
+        if (!same_expr(*x.indices[i], *y.indices[i], depth + 1)) return false;
+      return true;
+    }
+    case ExprKind::Unary: {
+      const auto& x = static_cast<const UnaryExpr&>(a);
+      const auto& y = static_cast<const UnaryExpr&>(b);
+      return x.op == y.op && same_expr(*x.operand, *y.operand, depth + 1);
+    }
+    case ExprKind::Binary: {
+      const auto& x = static_cast<const BinaryExpr&>(a);
+      const auto& y = static_cast<const BinaryExpr&>(b);
+      return x.op == y.op && same_expr(*x.lhs, *y.lhs, depth + 1) && same_expr(*x.rhs, *y.rhs, depth + 1);
+    }
+    default: return false;
+  }
+}
+
+// The array accesses in an expression that plain_read_type accepts: each of them is
+// evaluated, with its index checked, whenever the expression is.
+void collect_indexes(const Expr& e, std::vector<const IndexExpr*>* out, int depth) {
+  if (depth > 64) return;
+  switch (e.kind) {
+    case ExprKind::Member: collect_indexes(*static_cast<const MemberExpr&>(e).base, out, depth + 1); break;
+    case ExprKind::BitAccess: collect_indexes(*static_cast<const BitAccessExpr&>(e).base, out, depth + 1); break;
+    case ExprKind::Index: {
+      const auto& x = static_cast<const IndexExpr&>(e);
+      out->push_back(&x);
+      collect_indexes(*x.base, out, depth + 1);
+      for (const auto& i : x.indices) collect_indexes(*i, out, depth + 1);
+      break;
+    }
+    case ExprKind::Unary: collect_indexes(*static_cast<const UnaryExpr&>(e).operand, out, depth + 1); break;
+    case ExprKind::Binary:
+      collect_indexes(*static_cast<const BinaryExpr&>(e).lhs, out, depth + 1);
+      collect_indexes(*static_cast<const BinaryExpr&>(e).rhs, out, depth + 1);
+      break;
+    default: break;
+  }
+}
+}  // namespace
+
+const Type* Compiler::plain_read_type(const Expr& e, const std::vector<const IndexExpr*>* checked, int depth) {
+  if (depth > 64) return nullptr;
+  switch (e.kind) {
+    case ExprKind::Literal: {
+      const auto& l = static_cast<const LiteralExpr&>(e);
+      if (l.lit == LiteralKind::Bool) return elem(TypeKind::Bool);
+      // A number takes its type from the context; only "some integer" matters here.
+      if (l.lit == LiteralKind::Int || l.lit == LiteralKind::Real) return elem(TypeKind::LInt);
+      return nullptr;
+    }
+    case ExprKind::Name: {
+      const Symbol* s = lookup(canon(static_cast<const NameExpr&>(e).name.text));
+      // Not a variable: a property read by its bare name, a POU, a qualified enum value.
+      if (!s || s->kind != SymKind::Var || !s->type || s->where == Where::InOut) return nullptr;
+      if (s->type->kind == TypeKind::Ref || s->type->kind == TypeKind::Interface) return nullptr;
+      return s->type;
+    }
+    case ExprKind::Member: {
+      const auto& m = static_cast<const MemberExpr&>(e);
+      const Type* bt = plain_read_type(*m.base, checked, depth + 1);
+      if (!bt || (bt->kind != TypeKind::Struct && bt->kind != TypeKind::Pou)) return nullptr;
+      const Field* f = bt->field(m.member.text);  // none: a property (its getter is a call)
+      if (!f || !f->type || f->type->kind == TypeKind::Ref || f->type->kind == TypeKind::Interface) return nullptr;
+      return f->type;
+    }
+    case ExprKind::BitAccess: {
+      const Type* bt = plain_read_type(*static_cast<const BitAccessExpr&>(e).base, checked, depth + 1);
+      return bt && (bt->is_bitstring() || bt->is_integer()) ? elem(TypeKind::Bool) : nullptr;
+    }
+    case ExprKind::Index: {
+      const auto& x = static_cast<const IndexExpr&>(e);
+      const Type* at = plain_read_type(*x.base, checked, depth + 1);
+      if (!at || at->kind != TypeKind::Array || at->open || x.indices.size() != at->dims.size()) return nullptr;
+      bool constant = true;
+      for (const auto& i : x.indices) {
+        const Type* it = plain_read_type(*i, checked, depth + 1);
+        if (!it || !it->is_integer()) return nullptr;
+        if (i->kind != ExprKind::Literal) constant = false;  // a literal index is checked by the compiler
+      }
+      // A variable index could fail its bounds check; not when the same access was
+      // evaluated (and checked) before, with nothing written since.
+      if (!constant && checked &&
+          std::none_of(checked->begin(), checked->end(), [&](const IndexExpr* c) { return same_expr(*c, x, 0); }))
+        return nullptr;
+      return at->elem;
+    }
+    case ExprKind::Unary: return plain_read_type(*static_cast<const UnaryExpr&>(e).operand, checked, depth + 1);
+    case ExprKind::Binary: {
+      const auto& b = static_cast<const BinaryExpr&>(e);
+      if (b.op == BinaryOp::Pow || b.op == BinaryOp::AndThen || b.op == BinaryOp::OrElse) return nullptr;
+      if (b.op == BinaryOp::Div || b.op == BinaryOp::Mod) {
+        // Only by a number written out that is not zero: a variable divisor may be zero.
+        if (b.rhs->kind != ExprKind::Literal) return nullptr;
+        const auto& d = static_cast<const LiteralExpr&>(*b.rhs);
+        if (!(d.lit == LiteralKind::Int && d.int_value != 0) && !(d.lit == LiteralKind::Real && d.real_value != 0))
+          return nullptr;
+      }
+      const Type* l = plain_read_type(*b.lhs, checked, depth + 1);
+      const Type* r = l ? plain_read_type(*b.rhs, checked, depth + 1) : nullptr;
+      if (!l || !r) return nullptr;
+      switch (b.op) {
+        case BinaryOp::Lt: case BinaryOp::Gt: case BinaryOp::Le: case BinaryOp::Ge: case BinaryOp::Eq: case BinaryOp::Ne:
+          return elem(TypeKind::Bool);
+        case BinaryOp::And: case BinaryOp::Or: case BinaryOp::Xor:
+          return l->kind == TypeKind::Bool && r->kind == TypeKind::Bool ? l : (l->kind == TypeKind::Bool ? r : l);
+        default: return l;
+      }
+    }
+    default: return nullptr;
+  }
+}
+
+// An AND or OR chain of conditions as jumps, the way C compiles && and ||: for AND, each
+// term FALSE jumps out; for OR, each term TRUE jumps in. IEC evaluates every operand of
+// AND and OR, so the terms after the first are chained only when leaving them out cannot
+// be seen: they read variables and nothing else, and cannot fail (plain_read_type; an
+// element access whose index the first term already checked counts). `IF tags[i].zone =
+// z AND tags[i].alarm THEN` is then two fused element jumps, not two loads, a comparison,
+// an AND and a jump; the same for `IF pi1.sat OR pi2.sat OR pi3.sat THEN`.
+bool Compiler::chain_terms(const Expr& e, std::vector<const Expr*>* terms) {
+  if (!opt_.condition_jumps || !is_and_or(e)) return false;
+  const BinaryOp op = static_cast<const BinaryExpr&>(e).op;
+  // a AND b AND c is ((a AND b) AND c): the left spine of the one operator, in order.
+  terms->clear();
+  const Expr* n = &e;
+  while (n->kind == ExprKind::Binary && static_cast<const BinaryExpr*>(n)->op == op) {
+    terms->push_back(static_cast<const BinaryExpr*>(n)->rhs.get());
+    n = static_cast<const BinaryExpr*>(n)->lhs.get();
+  }
+  terms->push_back(n);
+  std::reverse(terms->begin(), terms->end());
+  std::vector<const IndexExpr*> checked;
+  for (size_t k = 0; k < terms->size(); ++k) {
+    const Expr& t = *(*terms)[k];
+    // A constant term keeps the whole condition a value (folded, warned about).
+    if (t.kind == ExprKind::Literal || t.kind == ExprKind::EnumLiteral) return false;
+    if (k > 0) {
+      const Type* tt = plain_read_type(t, &checked, 0);
+      if (!tt || tt->kind != TypeKind::Bool) return false;
+    }
+    // A term compiled as a value evaluates all its accesses: they prove the same
+    // accesses in the terms after it (a chain of jumps inside a term does not).
+    if (!is_and_or(t) && !(t.kind == ExprKind::Unary && static_cast<const UnaryExpr&>(t).op == UnaryOp::Not) &&
+        plain_read_type(t, nullptr, 0))
+      collect_indexes(t, &checked, 0);
+  }
+  return true;
+}
+
+Val Compiler::cond_branch(const Expr& e, Label target, bool when_true) {
+  std::vector<const Expr*> terms;
+  // NOT (a OR b): the chain of a OR b, jumping on the other outcome.
+  if (e.kind == ExprKind::Unary && static_cast<const UnaryExpr&>(e).op == UnaryOp::Not &&
+      chain_terms(*static_cast<const UnaryExpr&>(e).operand, &terms))
+    return cond_branch(*static_cast<const UnaryExpr&>(e).operand, target, !when_true);
+  if (chain_terms(e, &terms)) {
+    app_->condition_chains = true;
+    const bool decides = static_cast<const BinaryExpr&>(e).op == BinaryOp::Or;  // the value of a term that decides the whole
+    const uint32_t saved = b_->temp_top;
+    Val v;
+    if (when_true == decides) {
+      for (size_t k = 0; k < terms.size() && v.ok; ++k) {
+        v = cond_branch(*terms[k], target, decides);
+        b_->temp_top = saved;
+      }
+    } else {
+      Label skip = new_label();
+      for (size_t k = 0; k < terms.size() && v.ok; ++k) {
+        const bool last = k + 1 == terms.size();
+        v = cond_branch(*terms[k], last ? target : skip, last ? !decides : decides);
+        b_->temp_top = saved;
+      }
+      bind_forward(skip);
+    }
+    if (!v.ok) return bad();
+    Val out;
+    out.type = elem(TypeKind::Bool);
+    return out;
+  }
+  Val v = cond(e);
+  if (v.ok) branch_on(v, e.loc, target, when_true);
+  return v;
+}
+
+namespace {
 struct DepthScope {
   int& depth;
   explicit DepthScope(int& d) : depth(d) { ++depth; }
@@ -500,11 +720,10 @@ void Compiler::if_stmt(const IfStmt& s) {
     const auto& arm = s.arms[i];
     uint32_t saved = b_->temp_top;
     mark(arm.loc);
-    Val c = cond(*arm.cond);
+    Label next = new_label();
+    Val c = cond_branch(*arm.cond, next, false);
     if (opt_.warnings && c.ok && c.is_const && !(b_->pou && b_->pou->is_stdlib))
       diags_.warning("ST404", arm.cond->loc, std::string("condition is always ") + (c.c.i ? "TRUE" : "FALSE"));
-    Label next = new_label();
-    if (c.ok) branch_on(c, arm.cond->loc, next, false);
     b_->temp_top = saved;
     {
       const char* kind = !arm.label.empty() ? arm.label.c_str() : i == 0 ? "IF" : "ELSIF";
@@ -1078,8 +1297,7 @@ void Compiler::for_stmt(const ForStmt& s) {
 void Compiler::bottom_test(const Expr& c, Label body, bool again) {
   const uint32_t top = b_->temp_top;
   mark(c.loc);
-  Val v = cond(c);
-  if (v.ok) branch_on(v, c.loc, body, again);
+  cond_branch(c, body, again);
   b_->temp_top = top;
 }
 
@@ -1090,9 +1308,7 @@ void Compiler::bottom_test(const Expr& c, Label body, bool again) {
 void Compiler::while_stmt(const WhileStmt& s) {
   Label body = new_label(), test = new_label(), exit = new_label();
   uint32_t saved = b_->temp_top;
-  Val c = cond(*s.cond);
-  if (!c.ok) return;
-  branch_on(c, s.cond->loc, exit, false);
+  if (!cond_branch(*s.cond, exit, false).ok) return;
   b_->temp_top = saved;
   uint32_t decision = kNoBranch;
   {

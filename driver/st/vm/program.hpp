@@ -211,6 +211,9 @@ class Application {
   std::unique_ptr<TypeTable> types;
   std::vector<std::pair<std::string, const Type*>> type_names;  // declared TYPEs, as spelt
   bool has_configuration = false;
+  // Some IF, WHILE or REPEAT condition is a chain of conditional jumps, not one jump on its
+  // value (CompileOptions::condition_jumps): mutation analysis needs the one jump.
+  bool condition_chains = false;
   // FB_init/FB_exit (CODESYS): a routine over every program instance and global instance,
   // run by Machine::cold_restart/warm_restart on the frame at lifecycle_addr.
   // The byte at init_flag_addr is what FB_init gets as bInitRetains.

@@ -67,7 +67,9 @@ struct Small {
   std::vector<Mutant> mutants;
 
   Small() {
-    cb.build = st::build_sources({{"small.st", kProgram}}, st::CompileOptions{});
+    st::CompileOptions whole;
+    whole.condition_jumps = false;  // as `plcfi mutate` compiles (Campaign::whole_conditions)
+    cb.build = st::build_sources({{"small.st", kProgram}}, whole);
     EXPECT_TRUE(cb.build->ok()) << cb.build->diags.render_all();
     FmeaRow row;
     row.alarm = "gAlarm";
@@ -207,14 +209,28 @@ std::string read(const fs::path& p) {
   return ss.str();
 }
 
-CampaignBuild stamping_fixed() {
+CampaignBuild stamping_fixed(bool whole_conditions = true) {
   Campaign c;
   std::string err;
   EXPECT_TRUE(load_campaign((kRoot / "faults/campaigns/stamping/campaign.yaml").string(), &c, &err)) << err;
   c.programs = {(kRoot / "st_programs/stamping/stamping_fixed.st").string()};
+  c.whole_conditions = whole_conditions;  // true: as `plcfi mutate` prepares it
   CampaignBuild cb;
   EXPECT_TRUE(prepare_campaign(std::move(c), &cb, &err)) << err;
   return cb;
+}
+
+TEST(Mutate, ConditionsCompiledAsChainsOfJumpsAreRefused) {
+  // `IF (gSliderError OR gStampCylError) AND NOT gStampStop THEN` is a chain of three
+  // jumps when compiled for a campaign; negating the last of them is no mutant of the IF.
+  CampaignBuild chained = stamping_fixed(false);
+  ASSERT_TRUE(chained.build && chained.build->app);
+  EXPECT_TRUE(chained.build->app->condition_chains);
+  MutationRun r;
+  std::string err;
+  EXPECT_FALSE(run_mutation(chained, MutateOptions{}, &r, &err));
+  EXPECT_NE(err.find("chains of jumps"), std::string::npos) << err;
+  EXPECT_FALSE(stamping_fixed().build->app->condition_chains);
 }
 
 TEST(Mutate, StampingJournalSameWithWorkersAndMergedShards) {
