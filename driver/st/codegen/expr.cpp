@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "compiler_impl.hpp"
+#include "vm/ops.hpp"
 
 namespace plcfi::st::detail {
 
@@ -1019,8 +1020,7 @@ Val Compiler::combine(BinaryOp op, const Val& l, const Val& r, SourceLoc loc) {
   if (!t->is_numeric() && !t->is_bitstring()) return op_error();
   // Division by a constant: multiply by a precomputed reciprocal instead of dividing.
   if (by_const) {
-    uint64_t k = static_cast<uint64_t>(r.c.i < 0 ? -r.c.i : r.c.i);
-    uint64_t m = (uint64_t(1) << 63) / k + 1;
+    const uint64_t m = ops::divk_constants(r.c.i);
     bool i16 = t->storage() == Storage::I16;
     Op divop = e.op == BinaryOp::Div ? (i16 ? Op::DIVK_I16 : Op::DIVK_I32) : (i16 ? Op::MODK_I16 : Op::MODK_I32);
     Slot d = temp_for(t);

@@ -162,16 +162,32 @@ inline double f64_bits(uint64_t b) {
   return d;
 }
 
-// DIVK/MODK: q = floor(|n| * M / 2^63), M = floor(2^63/|K|) + 1, exact for 32-bit n;
-// the sign of the dividend (IEC truncates toward zero).
+// DIVK/MODK, |K| >= 2: the quotient of n by |K| is floor(n * M / 2^S), plus 1 for a
+// negative n, with l = ceil(log2 |K|), M = 1 + floor(2^(31 + l) / |K|) and S = 31 + l
+// (Granlund and Montgomery, "Division by invariant integers using multiplication", 1994,
+// figure 5.2 with N = 32): exact for every 32-bit n, M at most 2^32 so that the product
+// fits 64 bits. The sign flips for a negative K (IEC truncates toward zero). One 64-bit
+// multiply, a shift and a subtraction on the dividend's path. `ms`: M in bits 0 to 39,
+// S from bit 40 (divk_constants).
 template <class T, bool IsMod>
-inline T divk(T nv, uint64_t m, int32_t kv) {
-  int64_t n = nv;
-  int64_t k = kv;
-  uint64_t un = static_cast<uint64_t>(n < 0 ? -n : n);
-  auto q = static_cast<int64_t>(static_cast<uint64_t>((static_cast<U128>(un) * m) >> 63));
-  if ((n < 0) != (k < 0)) q = -q;
-  return static_cast<T>(IsMod ? n - q * k : q);
+inline T divk(T nv, uint64_t ms, int32_t kv) {
+  const int64_t n = nv;
+  const auto magic = static_cast<int64_t>(ms & ((uint64_t(1) << 40) - 1));
+  const auto shift = static_cast<unsigned>(ms >> 40);
+  int64_t q = ((n * magic) >> shift) - (n >> 63);
+  const int64_t flip = int64_t{kv} >> 63;  // -1 for a negative K, else 0
+  q = (q ^ flip) - flip;
+  return static_cast<T>(IsMod ? n - q * kv : q);
+}
+
+// The word DIVK and MODK carry for a divisor K (|K| from 2 to 2^31): M and S as divk
+// reads them.
+inline uint64_t divk_constants(int64_t k) {
+  const uint64_t ak = static_cast<uint64_t>(k < 0 ? -k : k);
+  unsigned l = 0;  // ceil(log2 |K|)
+  while ((uint64_t(1) << l) < ak) ++l;
+  const uint64_t m = 1 + (uint64_t(1) << (31 + l)) / ak;
+  return m | (uint64_t{31 + l} << 40);
 }
 
 // WSTRING: UTF-16 code units, ended by a 0 unit, at any address (memcpy, no aligned

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "engine.hpp"
+#include "vm/ops.hpp"
 
 namespace plcfi::st {
 namespace {
@@ -45,6 +46,41 @@ TEST(DivisionByConstant, DintMatchesHardwareDivision) {
 
 TEST(DivisionByConstant, IntMatchesHardwareDivision) {
   for (int32_t k : {2, 3, 5, 7, 100, 1000, 32767, -3, -100}) check_divisor<int16_t>(k, "INT");
+}
+
+// The instruction's arithmetic itself (ops::divk with ops::divk_constants), against the
+// hardware's division, on many more divisors than the programs above: every one up to
+// 600, each power of two and its neighbours, large primes, all of them negated too; the
+// dividends at the type's ends, around multiples of the divisor, and random.
+TEST(DivisionByConstant, MultiplyAndShiftMatchHardwareDivision) {
+  std::vector<int64_t> divisors;
+  for (int64_t k = 2; k <= 600; ++k) divisors.push_back(k);
+  for (int s = 10; s <= 31; ++s)
+    for (int64_t d : {-1, 0, 1}) divisors.push_back((int64_t{1} << s) + d);
+  for (int64_t k : {65521, 1000003, 134456, 139968, 2147483629, INT32_MAX}) divisors.push_back(k);
+  const size_t positive = divisors.size();
+  for (size_t i = 0; i < positive; ++i) divisors.push_back(-divisors[i]);
+  std::mt19937 rng(2024);
+  for (int64_t k : divisors) {
+    if (k > INT32_MAX || k < INT32_MIN + 1) continue;
+    const uint64_t ms = ops::divk_constants(k);
+    const auto k32 = static_cast<int32_t>(k);
+    std::vector<int64_t> values{0, 1, -1, INT32_MIN, INT32_MAX, INT32_MIN + 1, INT32_MAX - 1};
+    for (int64_t j = -3; j <= 3; ++j)
+      for (int64_t d : {-1, 0, 1}) values.push_back(j * k + d);
+    for (int i = 0; i < 300; ++i) values.push_back(static_cast<int32_t>(rng()));
+    for (int64_t v : values) {
+      if (v < INT32_MIN || v > INT32_MAX) continue;
+      const auto n = static_cast<int32_t>(v);
+      ASSERT_EQ((ops::divk<int32_t, false>(n, ms, k32)), n / k32) << n << " / " << k;
+      ASSERT_EQ((ops::divk<int32_t, true>(n, ms, k32)), n % k32) << n << " MOD " << k;
+      const auto h = static_cast<int16_t>(v);
+      if (k >= -32768 && k <= 32767) {
+        ASSERT_EQ((ops::divk<int16_t, false>(h, ms, k32)), static_cast<int16_t>(h / k32)) << h << " / " << k;
+        ASSERT_EQ((ops::divk<int16_t, true>(h, ms, k32)), static_cast<int16_t>(h % k32)) << h << " MOD " << k;
+      }
+    }
+  }
 }
 
 }  // namespace
