@@ -135,7 +135,8 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   const Campaign& c = out->spec;
   st::CompileOptions opt;
   opt.warnings = false;
-  opt.condition_jumps = !c.whole_conditions;
+  opt.condition_jumps = !c.for_mutation;
+  opt.loop_tails = !c.for_mutation;
   st::parse_dialect(c.dialect, &opt.dialect);  // checked when the file was read
 
   // 1. The program alone: bindings, alarms and fault targets are checked against it.

@@ -62,7 +62,7 @@ struct Mutant {
 };
 
 // The mutants of the campaign's program (compiled with CompileOptions::condition_jumps
-// off: Campaign::whole_conditions), in a deterministic order (POU code order, then
+// and loop_tails off: Campaign::for_mutation), in a deterministic order (POU code order, then
 // operator). Equivalence proofs are filled in: byte-identical patch, duplicate of an
 // earlier mutant, or code unreachable from every task entry.
 std::vector<Mutant> generate_mutants(const CampaignBuild& cb);

@@ -167,9 +167,10 @@ struct Campaign {
   RestartKind restart = RestartKind::Cold;
   std::string io;  // a file with an io: section: the campaign runs on real I/O (needs --arm)
   ExploreSettings explore;
-  // Each IF, WHILE and REPEAT condition compiled as one value and one jump on it, not as a
-  // chain of jumps (CompileOptions::condition_jumps): what mutation analysis patches.
-  bool whole_conditions = false;
+  // Compiled for mutation analysis, which patches one jump per condition and one store per
+  // assignment: each IF, WHILE and REPEAT condition one value and one jump on it, no
+  // statement copied into an IF's arms (CompileOptions::condition_jumps and loop_tails off).
+  bool for_mutation = false;
   // EDTL requirements (a requirements file) that an explored case must not violate to count
   // as tolerated; "" = none. FMEA cases do not use them.
   std::string requirements;

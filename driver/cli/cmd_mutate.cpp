@@ -94,9 +94,10 @@ bool prepare_judge(const po::variables_map& vm, campaign::CampaignBuild* cb) {
   // Campaign options that change what runs per mutant are set on the spec here, before the
   // one preparation: every mutant runs the same campaign.
   if (vm.count("explore")) spec.explore.enabled = true;
-  // A mutant negates, drops or forces the one conditional jump of an IF (mutate_gen.cpp):
-  // conditions compiled as chains of jumps would have several.
-  spec.whole_conditions = true;
+  // A mutant negates, drops or forces the one conditional jump of an IF, or removes the one
+  // store of an assignment (mutate_gen.cpp): conditions compiled as chains of jumps and
+  // assignments copied into arms would have several.
+  spec.for_mutation = true;
   if (!campaign::prepare_campaign(std::move(spec), cb, &err)) {
     std::cerr << err << (err.empty() || err.back() == '\n' ? "" : "\n");
     return false;

@@ -34,8 +34,10 @@ struct CompileOptions {
   // no coverage (`plcfi run` without --coverage), which then spend nothing on it.
   bool coverage = true;
   // An IF or CASE that ends a loop body ends its arms with a copy of the loop's bottom
-  // (LOOPUP, the WHILE or UNTIL test) instead of a jump to it (see loop_tail_); off, with
-  // the jump (tests compare the two).
+  // (LOOPUP, the WHILE or UNTIL test) instead of a jump to it (see loop_tail_), one that
+  // only a few short assignments follow with a copy of them and the bottom (see stmts);
+  // off, with the jump (tests compare the two; mutation analysis patches one store per
+  // assignment).
   bool loop_tails = true;
   // An IF, WHILE or REPEAT condition that is an AND or OR of terms, whose later terms only
   // read variables and cannot fail, is a chain of conditional jumps (see cond_branch);

@@ -394,16 +394,84 @@ struct DepthScope {
   DepthScope(const DepthScope&) = delete;
   DepthScope& operator=(const DepthScope&) = delete;
 };
+
+// The nodes of an expression, up to `limit` (more: limit + 1); a call counts as one node
+// and its arguments.
+size_t plain_size(const Expr& e, size_t limit) {
+  size_t n = 0;
+  std::vector<const Expr*> work{&e};
+  while (!work.empty() && n <= limit) {
+    const Expr* x = work.back();
+    work.pop_back();
+    ++n;
+    switch (x->kind) {
+      case ExprKind::Member: work.push_back(static_cast<const MemberExpr*>(x)->base.get()); break;
+      case ExprKind::BitAccess: work.push_back(static_cast<const BitAccessExpr*>(x)->base.get()); break;
+      case ExprKind::Index:
+        work.push_back(static_cast<const IndexExpr*>(x)->base.get());
+        for (const auto& i : static_cast<const IndexExpr*>(x)->indices) work.push_back(i.get());
+        break;
+      case ExprKind::Deref: work.push_back(static_cast<const DerefExpr*>(x)->base.get()); break;
+      case ExprKind::Unary: work.push_back(static_cast<const UnaryExpr*>(x)->operand.get()); break;
+      case ExprKind::Binary:
+        work.push_back(static_cast<const BinaryExpr*>(x)->lhs.get());
+        work.push_back(static_cast<const BinaryExpr*>(x)->rhs.get());
+        break;
+      case ExprKind::Call:
+        for (const auto& a : static_cast<const CallExpr*>(x)->args) {
+          if (a.is_output) return limit + 1;  // f(x, OUT => y) writes y
+          if (a.value) work.push_back(a.value.get());
+        }
+        break;
+      case ExprKind::ArrayInit: case ExprKind::StructInit: return limit + 1;
+      default: break;
+    }
+  }
+  return n;
+}
+
+// Whether the statements of `list` from `from` on are a few small assignments (no REF=,
+// S=/R=, chained or declaring assignment, no output argument): a copy of them is short.
+bool short_rest(const StmtList& list, size_t from) {
+  constexpr size_t kMaxStatements = 2, kMaxNodes = 32;
+  if (from >= list.size() || list.size() - from > kMaxStatements) return false;
+  size_t nodes = 0;
+  for (size_t j = from; j < list.size(); ++j) {
+    if (list[j]->kind != StmtKind::Assign) return false;
+    const auto& a = static_cast<const AssignStmt&>(*list[j]);
+    if (a.is_ref_assign || a.set_reset || a.chained || a.declares_temp) return false;
+    nodes += plain_size(*a.lhs, kMaxNodes) + plain_size(*a.rhs, kMaxNodes);
+    if (nodes > kMaxNodes) return false;
+  }
+  return true;
+}
 }  // namespace
 
 void Compiler::stmts(const StmtList& list) {
   DepthScope depth(b_->stmt_depth);
   if (b_->stmt_depth == 1) declare_labels(list);
   bool dead = false;
-  // Only the last statement of the list ends where the list does (see loop_tail_).
+  // Only the last statement of the list ends where the list does (see loop_tail_); an IF
+  // or CASE that only a few short assignments follow (`steps := steps + 1;` after an
+  // IF in a WHILE body) ends its arms with a copy of them and of the loop's bottom: the
+  // arms that jumped to the IF's end now go on as the code after it does, without the
+  // jump (the tail duplication of C compilers).
   const std::function<void()>* const tail = loop_tail_;
-  for (const auto& s : list) {
-    loop_tail_ = &s == &list.back() ? tail : nullptr;
+  std::function<void()> longer;
+  for (size_t k = 0; k < list.size(); ++k) {
+    const auto& s = list[k];
+    loop_tail_ = k + 1 == list.size() ? tail : nullptr;
+    if (tail && k + 1 < list.size() && (s->kind == StmtKind::If || s->kind == StmtKind::Case) && short_rest(list, k + 1)) {
+      longer = [this, &list, k, tail] {
+        app_->copied_statements = true;
+        const std::function<void()>* const inside = loop_tail_;
+        loop_tail_ = nullptr;
+        for (size_t j = k + 1; j < list.size(); ++j) stmt(*list[j]);
+        (*tail)();
+        loop_tail_ = inside;
+      };
+      loop_tail_ = &longer;
+    }
     if (s->kind == StmtKind::Label) dead = false;  // a jump may reach it
     if (dead && opt_.warnings && s->kind != StmtKind::Empty && !(b_->pou && b_->pou->is_stdlib)) {
       diags_.warning("ST402", s->loc, "unreachable statement");

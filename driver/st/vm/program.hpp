@@ -214,6 +214,9 @@ class Application {
   // Some IF, WHILE or REPEAT condition is a chain of conditional jumps, not one jump on its
   // value (CompileOptions::condition_jumps): mutation analysis needs the one jump.
   bool condition_chains = false;
+  // Some assignment is compiled more than once, copied into the arms of an IF or CASE
+  // before a loop's bottom (CompileOptions::loop_tails): mutation analysis needs one store.
+  bool copied_statements = false;
   // FB_init/FB_exit (CODESYS): a routine over every program instance and global instance,
   // run by Machine::cold_restart/warm_restart on the frame at lifecycle_addr.
   // The byte at init_flag_addr is what FB_init gets as bInitRetains.

@@ -194,6 +194,144 @@ END_PROGRAM
   EXPECT_EQ(off.get("P.k"), on.get("P.k"));
 }
 
+// An IF or CASE that one or two short assignments follow at the end of a loop body: its
+// arms end with a copy of them and of the loop's bottom. Each assignment adds its own
+// weight, so a copy that is missing, doubled or in the wrong arm changes the sums.
+const char* kRest = R"(PROGRAM P
+VAR
+  n, steps, i, s, t, u, seed, state, k : DINT;
+  w : WORD;
+  odd : DINT;
+  frame : ARRAY [0..31] OF BYTE;
+END_VAR
+(* WHILE: an IF/ELSE, then one assignment (Collatz) *)
+n := seed MOD 1000 + 27;
+steps := 0;
+WHILE n <> 1 DO
+  IF n MOD 2 = 0 THEN
+    n := n / 2;
+  ELSE
+    n := 3 * n + 1;
+  END_IF;
+  steps := steps + 1;
+END_WHILE;
+(* FOR: an IF/ELSIF/ELSE, then two assignments, one to an element *)
+w := 16#ACE1;
+s := 0;
+FOR i := 0 TO 31 DO
+  IF (w AND 16#0001) <> 16#0000 THEN
+    w := SHR(w, 1) XOR 16#B400;
+  ELSIF (w AND 16#0002) <> 16#0000 THEN
+    w := SHR(w, 1) XOR 16#0013;
+  ELSE
+    w := SHR(w, 1);
+  END_IF;
+  frame[(i * 5 + seed) MOD 32] := WORD_TO_BYTE(w XOR SHR(w, 5));
+  s := s + WORD_TO_DINT(w AND 16#00FF) * (i + 1);
+END_FOR;
+(* REPEAT: a CASE, then one assignment, and the UNTIL test *)
+state := 0;
+t := 0;
+u := 0;
+REPEAT
+  CASE state OF
+    0: state := 1;
+    1: state := 2; u := u + 100;
+  ELSE
+    state := 0;
+  END_CASE;
+  t := t + 1;
+UNTIL t >= 10 + seed MOD 4
+END_REPEAT;
+(* an IF without ELSE: nothing to copy into (its arm falls through) *)
+odd := 0;
+FOR i := 0 TO 31 DO
+  IF (BYTE_TO_DINT(frame[i]) MOD 3) = 0 THEN
+    odd := odd + 1;
+  END_IF;
+  k := k + i;
+END_FOR;
+(* three statements after the IF: not copied *)
+FOR i := 0 TO 3 DO
+  IF i = 2 THEN k := k + 7; ELSE k := k - 1; END_IF;
+  k := k + 1;
+  k := k * 3;
+  k := k MOD 100003;
+END_FOR;
+END_PROGRAM
+)";
+
+// The same sums computed here.
+struct RestSums {
+  int64_t steps = 0, s = 0, t = 0, u = 0, odd = 0, state = 0;
+};
+RestSums rest_by_hand(int64_t seed) {
+  RestSums r;
+  int64_t n = seed % 1000 + 27;
+  while (n != 1) {
+    n = n % 2 == 0 ? n / 2 : 3 * n + 1;
+    ++r.steps;
+  }
+  uint16_t w = 0xACE1;
+  uint8_t frame[32] = {};
+  for (int i = 0; i < 32; ++i) {
+    if (w & 1) w = static_cast<uint16_t>((w >> 1) ^ 0xB400);
+    else if (w & 2) w = static_cast<uint16_t>((w >> 1) ^ 0x0013);
+    else w = static_cast<uint16_t>(w >> 1);
+    frame[(i * 5 + seed) % 32] = static_cast<uint8_t>(w ^ (w >> 5));
+    r.s += (w & 0xFF) * (i + 1);
+  }
+  int64_t state = 0;
+  do {
+    if (state == 0) state = 1;
+    else if (state == 1) { state = 2; r.u += 100; }
+    else state = 0;
+    ++r.t;
+  } while (!(r.t >= 10 + seed % 4));
+  r.state = state;
+  for (uint8_t b : frame) r.odd += b % 3 == 0;
+  return r;
+}
+
+TEST(VmTails, AssignmentsAfterTheLastIfAreCopiedIntoItsArms) {
+  Prog on(kRest, true), off(kRest, false);
+  ASSERT_TRUE(on.ok() && off.ok());
+  EXPECT_TRUE(on.b->app->copied_statements);
+  EXPECT_FALSE(off.b->app->copied_statements);
+  const std::string dis = on.disasm(), plain = off.disasm();
+  // steps := steps + 1 in the THEN arm; the element store and the sum in the THEN and
+  // ELSIF arms; t := t + 1 in the two CASE arms before the ELSE. The IF without ELSE and
+  // the IF that three statements follow keep one copy of what follows them.
+  EXPECT_EQ(occurrences(plain, " STXN1 ") + occurrences(plain, " STX1 ") + 2,
+            occurrences(dis, " STXN1 ") + occurrences(dis, " STX1 "))
+      << dis;
+  // The element's index i * 5 + seed and the sum's product, each in the two arms.
+  EXPECT_EQ(occurrences(plain, " MUL_I32 ") + occurrences(plain, " MADD_I32 ") + 4,
+            occurrences(dis, " MUL_I32 ") + occurrences(dis, " MADD_I32 "))
+      << dis;
+  EXPECT_EQ(occurrences(plain, "steps := steps + 1") + 1, occurrences(dis, "steps := steps + 1")) << dis;
+  EXPECT_EQ(occurrences(plain, "t := t + 1") + 2, occurrences(dis, "t := t + 1")) << dis;
+  EXPECT_EQ(occurrences(plain, "k := k + i"), occurrences(dis, "k := k + i")) << dis;
+  EXPECT_EQ(occurrences(plain, "k := k MOD 100003"), occurrences(dis, "k := k MOD 100003")) << dis;
+  for (int64_t seed : {0, 1, 7, 4242, 99991}) {
+    on.set("P.seed", seed);
+    off.set("P.seed", seed);
+    ASSERT_TRUE(on.scan()) << on.m->trap().message;
+    ASSERT_TRUE(off.scan()) << off.m->trap().message;
+    const RestSums r = rest_by_hand(seed);
+    for (Prog* p : {&on, &off}) {
+      EXPECT_EQ(p->get("P.steps"), r.steps) << seed;
+      EXPECT_EQ(p->get("P.s"), r.s) << seed;
+      EXPECT_EQ(p->get("P.t"), r.t) << seed;
+      EXPECT_EQ(p->get("P.u"), r.u) << seed;
+      EXPECT_EQ(p->get("P.state"), r.state) << seed;
+      EXPECT_EQ(p->get("P.odd"), r.odd) << seed;
+    }
+    for (const char* v : {"P.k", "P.w", "P.frame[0]", "P.frame[17]", "P.frame[31]"}) EXPECT_EQ(off.get(v), on.get(v)) << v;
+  }
+  same_in_both_tiers("tails.st", kRest, 3);
+}
+
 // Rule 23: a conditional jump on a BOOL variable that the instruction just before set to
 // a constant, with no jump target between, is left out when it cannot be taken (the
 // insertion sort of kTails: see the count of WHILE test copies above). Where the flag is
