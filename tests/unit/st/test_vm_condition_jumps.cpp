@@ -240,6 +240,45 @@ PROGRAM P
 END_PROGRAM
 )";
   EXPECT_NE(trap_of(same).find("index 12 outside 0..7"), std::string::npos) << trap_of(same);
+  // CODESYS: a property's getter is a call (here it counts its reads), a REFERENCE TO is
+  // read through its address (here unbound: a null reference).
+  CompileOptions codesys = with_chains(true);
+  codesys.dialect = Dialect::Codesys;
+  const char* property = R"(
+FUNCTION_BLOCK Counted
+  VAR_OUTPUT reads : DINT; END_VAR
+  VAR v : BOOL := TRUE; END_VAR
+PROPERTY Value : BOOL
+GET
+  reads := reads + 1;
+  Value := v;
+END_GET
+END_PROPERTY
+END_FUNCTION_BLOCK
+PROGRAM P
+  VAR off : BOOL := FALSE; c : Counted; calls : DINT; END_VAR
+  IF off AND c.Value THEN calls := 100; END_IF;
+  calls := calls + c.reads;
+END_PROGRAM
+)";
+  {
+    VmRun p(property, codesys, "keep.st");
+    ASSERT_TRUE(p.ok());
+    ASSERT_TRUE(p.scan()) << p.m->trap().message;
+    EXPECT_EQ(p.get("P.calls"), 1);
+  }
+  const char* reference = R"(
+PROGRAM P
+  VAR off : BOOL := FALSE; r : REFERENCE TO DINT; calls : DINT; END_VAR
+  IF off AND r > 0 THEN calls := 1; END_IF;
+END_PROGRAM
+)";
+  {
+    VmRun p(reference, codesys, "keep.st");
+    ASSERT_TRUE(p.ok());
+    EXPECT_FALSE(p.scan());
+    EXPECT_EQ(p.m->trap().kind, TrapKind::NullReference) << p.m->trap().message;
+  }
   // Those that can be seen stay values: their AND or OR is in the listing.
   for (const char* src : {call, index, other, divide}) {
     VmRun p(src, with_chains(true), "keep.st");
