@@ -338,31 +338,33 @@ bool Compiler::chain_terms(const Expr& e, std::vector<const Expr*>* terms) {
     const Expr& t = *(*terms)[k];
     // A constant term keeps the whole condition a value (folded, warned about).
     if (t.kind == ExprKind::Literal || t.kind == ExprKind::EnumLiteral) return false;
-    if (k > 0) {
-      const Type* tt = plain_read_type(t, &checked, 0);
-      if (!tt || tt->kind != TypeKind::Bool) return false;
-    }
+    // The first term is evaluated whatever it holds; it may fail its own index checks.
+    const Type* tt = plain_read_type(t, k > 0 ? &checked : nullptr, 0);
+    if (k > 0 && (!tt || tt->kind != TypeKind::Bool)) return false;
     // A term compiled as a value evaluates all its accesses: they prove the same
     // accesses in the terms after it (a chain of jumps inside a term does not).
-    if (!is_and_or(t) && !(t.kind == ExprKind::Unary && static_cast<const UnaryExpr&>(t).op == UnaryOp::Not) &&
-        plain_read_type(t, nullptr, 0))
+    if (tt && !is_and_or(t) && !(t.kind == ExprKind::Unary && static_cast<const UnaryExpr&>(t).op == UnaryOp::Not))
       collect_indexes(t, &checked, 0);
   }
   return true;
 }
 
 Val Compiler::cond_branch(const Expr& e, Label target, bool when_true) {
-  std::vector<const Expr*> terms;
   // NOT (a OR b): the chain of a OR b, jumping on the other outcome.
-  if (e.kind == ExprKind::Unary && static_cast<const UnaryExpr&>(e).op == UnaryOp::Not &&
-      chain_terms(*static_cast<const UnaryExpr&>(e).operand, &terms))
-    return cond_branch(*static_cast<const UnaryExpr&>(e).operand, target, !when_true);
-  if (chain_terms(e, &terms)) {
+  const Expr* x = &e;
+  bool jump_when = when_true;
+  while (x->kind == ExprKind::Unary && static_cast<const UnaryExpr*>(x)->op == UnaryOp::Not &&
+         is_and_or(*static_cast<const UnaryExpr*>(x)->operand)) {
+    x = static_cast<const UnaryExpr*>(x)->operand.get();
+    jump_when = !jump_when;
+  }
+  std::vector<const Expr*> terms;
+  if (chain_terms(*x, &terms)) {
     app_->condition_chains = true;
-    const bool decides = static_cast<const BinaryExpr&>(e).op == BinaryOp::Or;  // the value of a term that decides the whole
+    const bool decides = static_cast<const BinaryExpr*>(x)->op == BinaryOp::Or;  // the value of a term that decides the whole
     const uint32_t saved = b_->temp_top;
     Val v;
-    if (when_true == decides) {
+    if (jump_when == decides) {
       for (size_t k = 0; k < terms.size() && v.ok; ++k) {
         v = cond_branch(*terms[k], target, decides);
         b_->temp_top = saved;
