@@ -323,5 +323,36 @@ END_PROGRAM
   }
 }
 
+// Long and deep conditions: a chain of 20,000 terms (one left spine), 120 levels of
+// parentheses alternating AND and OR, NOT of NOT 100 times, 5,000 element terms proven by
+// the first. They compile (no recursion along the spine) and compute what the values do.
+TEST(VmConditionJumps, LongAndDeepConditions) {
+  std::string chain = "a0";
+  for (int i = 1; i < 20000; ++i) chain += " AND a" + std::to_string(i % 4);
+  std::string deep = "a0";
+  for (int i = 0; i < 120; ++i) deep = "(" + deep + (i % 2 ? " AND a" : " OR a") + std::to_string(i % 4) + ")";
+  std::string nots;
+  for (int i = 0; i < 101; ++i) nots += "NOT ";
+  std::string elements = "t[i]";
+  for (int i = 1; i < 5000; ++i) elements += " OR t[" + (i % 3 ? std::to_string(i % 8) : std::string("i")) + "]";
+  const std::string src = "PROGRAM P\nVAR a0, a1, a2, a3 : BOOL; n, i : DINT; t : ARRAY [0..7] OF BOOL; END_VAR\n"
+                          "n := 0;\nIF " + chain + " THEN n := n + 1; END_IF;\n"
+                          "WHILE " + deep + " DO n := n + 10; a0 := NOT a0; a2 := FALSE; END_WHILE;\n"
+                          "IF " + nots + "(a0 OR a1) THEN n := n + 100; END_IF;\n"
+                          "IF " + elements + " THEN n := n + 1000; END_IF;\nEND_PROGRAM\n";
+  VmRun on(src, with_chains(true), "deep.st"), off(src, with_chains(false), "deep.st");
+  ASSERT_TRUE(on.ok() && off.ok());
+  EXPECT_TRUE(on.b->app->condition_chains);
+  for (int s = 0; s < 16; ++s) {
+    for (VmRun* p : {&on, &off}) {
+      for (int k = 0; k < 4; ++k) p->set("P.a" + std::to_string(k), (s >> k) & 1);
+      p->set("P.i", s % 8);
+      p->set("P.t[" + std::to_string((s * 3) % 8) + "]", s % 5 == 0);
+      ASSERT_TRUE(p->scan()) << p->m->trap().message;
+    }
+    EXPECT_EQ(on.get("P.n"), off.get("P.n")) << "scan " << s;
+  }
+}
+
 }  // namespace
 }  // namespace plcfi::st
