@@ -337,10 +337,10 @@ std::string run_fingerprint(const CampaignBuild& cb, const std::vector<Mutant>& 
 
 bool run_mutation(CampaignBuild& cb, const MutateOptions& opt, MutationRun* out, std::string* err) {
   auto wall0 = std::chrono::steady_clock::now();
-  if (cb.build->app->condition_chains || cb.build->app->copied_statements) {
+  if (cb.build->app->condition_chains || cb.build->app->copied_statements || cb.build->app->if_selects) {
     // The operators patch one jump per IF and one store per assignment (mutate_gen.cpp).
-    *err = "plcfi mutate: internal: the program was compiled with conditions as chains of jumps or statements copied "
-           "into arms (Campaign::for_mutation)";
+    *err = "plcfi mutate: internal: the program was compiled with conditions as chains of jumps, statements copied "
+           "into arms or IFs as selects (Campaign::for_mutation)";
     return false;
   }
   out->mutants = generate_mutants(cb);

@@ -95,14 +95,18 @@ int cmd_check(const std::vector<std::string>& args) {
 
 int cmd_disasm(const std::vector<std::string>& args) {
   po::options_description desc("plcfi disasm: print the bytecode of ST files with their source lines");
-  desc.add_options()("native", "print the C++ the native tier generates instead");
+  desc.add_options()("native", "print the C++ the native tier generates instead")(
+      "coverage", "the code `run --coverage` runs: a COV per branch arm, every IF with jumps");
   po::variables_map vm;
   add_dialect_options(desc);
-  if (!parse_args(args, desc, vm, "plcfi disasm FILES... [--native]")) return 0;
+  if (!parse_args(args, desc, vm, "plcfi disasm FILES... [--native] [--coverage]")) return 0;
   st::CompileOptions opt;
   apply_dialect_options(vm, &opt);
   opt.warnings = false;
-  opt.loop_tails = !vm.count("native");  // as `run --native` compiles it
+  // As `run` compiles it (with --native: as `run --native` does).
+  opt.coverage = vm.count("coverage") > 0;
+  opt.loop_tails = !vm.count("native");
+  opt.if_selects = !vm.count("native");
   auto b = load(strings_of(vm, "files"), opt, "disasm");
   if (!b || !b->ok()) return 2;
   if (vm.count("native")) {
@@ -317,6 +321,7 @@ int cmd_run(const std::vector<std::string>& args) {
   // itself and optimizes a loop with one bottom better (crc16_parity: 6 % more
   // instructions with them).
   opt.loop_tails = !vm.count("native");
+  opt.if_selects = !vm.count("native");  // the C++ compiler chooses between jumps and selects itself
   auto b = load(strings_of(vm, "files"), opt, "run");
   if (!b || !b->ok()) return 2;
   const st::Application& app = *b->app;

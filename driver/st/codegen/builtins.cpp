@@ -597,6 +597,14 @@ std::optional<Val> Compiler::emit_select(const StdFunc& f, const CallExpr& c) {
     Val gc = coerce(g, elem(TypeKind::Bool), args[0]->loc, "SEL");
     if (!gc.ok) return bad();
     Slot gs = to_slot(gc, elem(TypeKind::Bool), args[0]->loc);
+    if (!t->is_string() && (t->size == 1 || t->size == 2 || t->size == 4 || t->size == 8)) {
+      // Both inputs are values already: one select, no branch.
+      emit(sel_op(t->size), {d, gs, slots[1], slots[0]});
+      def(d, 1);
+      Val out = slot_val(t, d);
+      out.nominal = register_nominal(vals, t);
+      return out;
+    }
     Label l0 = new_label();
     emit(Op::JMPF, {Arg::target(l0.id), gs});
     copy(slots[1]);

@@ -101,6 +101,15 @@ Op mov_op(uint32_t size) {
   }
 }
 
+Op sel_op(uint32_t size) {
+  switch (size) {
+    case 1: return Op::SEL1;
+    case 2: return Op::SEL2;
+    case 4: return Op::SEL4;
+    default: return Op::SEL8;
+  }
+}
+
 ValueKind value_kind(const Type* t) {
   switch (t->kind) {
     case TypeKind::Bool: return ValueKind::Bool;

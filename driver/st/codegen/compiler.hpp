@@ -43,6 +43,12 @@ struct CompileOptions {
   // read variables and cannot fail, is a chain of conditional jumps (see cond_branch);
   // off, one value and one jump on it (mutation analysis patches that jump).
   bool condition_jumps = true;
+  // An IF whose condition tests bits (an element of a BOOL array, a bit of a word, (x AND
+  // mask) or x MOD 2^k compared with 0) and whose arms assign one variable values that only read
+  // variables and cannot fail is one select instruction, without a jump (see select_if);
+  // only without coverage (the arms mark nothing then). Off, jumps (mutation analysis
+  // negates the IF's one jump; the native tier leaves the choice to the C compiler).
+  bool if_selects = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

@@ -361,6 +361,14 @@ class Compiler {
   // any index, e may fail a bounds check), else null.
   const Type* plain_read_type(const Expr& e, const std::vector<const IndexExpr*>* checked, int depth);
   bool test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero);
+  // Rule 26: an IF on a test of bits whose arms assign one variable values that cannot
+  // fail, compiled as a select (CompileOptions::if_selects; see stmt.cpp). False:
+  // nothing emitted, the IF is compiled with jumps.
+  bool select_if(const IfStmt& s);
+  // Whether evaluating e only reads variables, calls standard functions that compute a
+  // value from their inputs (shifts, MIN, MAX, LIMIT, MOVE, numeric conversions) and
+  // cannot fail (the rules of plain_read_type).
+  bool select_safe(const Expr& e, const std::vector<const IndexExpr*>* checked, int depth);
   // For the peepholes that read code just emitted: the slot kind of the operand at a code
   // word, and the value of a constant pool slot of `width` bytes there (nullopt: none).
   SK kind_at(uint32_t word) const;
@@ -685,6 +693,7 @@ Op num_op(Op i8_variant, Storage s);
 Op int_op(Op i8_variant, Storage s);
 Op cvt_op(Storage from, Storage to);
 Op mov_op(uint32_t size);  // 1, 2, 4, 8; else MOVN
+Op sel_op(uint32_t size);  // SEL1, SEL2, SEL4, SEL8 (size 1, 2, 4, 8)
 ValueKind value_kind(const Type* t);
 // The copy of a string of type t into a string of its kind: SCPY bytes, WSCPY code units.
 inline Op string_copy_op(const Type* t) { return t->kind == TypeKind::WString ? Op::WSCPY : Op::SCPY; }

@@ -1,11 +1,13 @@
 // Statements: assignment, calls, IF, CASE, FOR, WHILE, REPEAT, EXIT, CONTINUE, RETURN,
 // and the test-file statements; every branch arm gets a coverage id.
 #include <algorithm>
+#include <bit>
 #include <set>
 
 #include <cstring>
 
 #include "compiler_impl.hpp"
+#include "sema/stdfuncs.hpp"
 
 namespace plcfi::st::detail {
 
@@ -783,7 +785,203 @@ void Compiler::assign_stmt(const AssignStmt& s) {
   assign(dst, v, s.loc);
 }
 
+bool Compiler::select_safe(const Expr& e, const std::vector<const IndexExpr*>* checked, int depth) {
+  if (depth > 64) return false;
+  switch (e.kind) {
+    case ExprKind::EnumLiteral: return true;
+    case ExprKind::Literal: {
+      const LiteralKind k = static_cast<const LiteralExpr&>(e).lit;
+      return k != LiteralKind::String && k != LiteralKind::WString;  // numbers, BOOL, times, dates
+    }
+    case ExprKind::Unary: return select_safe(*static_cast<const UnaryExpr&>(e).operand, checked, depth + 1);
+    case ExprKind::Binary: {
+      const auto& b = static_cast<const BinaryExpr&>(e);
+      if (b.op == BinaryOp::Pow || b.op == BinaryOp::AndThen || b.op == BinaryOp::OrElse) return false;
+      if (b.op == BinaryOp::Div || b.op == BinaryOp::Mod) {
+        if (b.rhs->kind != ExprKind::Literal) return false;  // a variable divisor may be zero
+        const auto& d = static_cast<const LiteralExpr&>(*b.rhs);
+        if (!(d.lit == LiteralKind::Int && d.int_value != 0) && !(d.lit == LiteralKind::Real && d.real_value != 0))
+          return false;
+      }
+      return select_safe(*b.lhs, checked, depth + 1) && select_safe(*b.rhs, checked, depth + 1);
+    }
+    case ExprKind::Call: {
+      const auto& c = static_cast<const CallExpr&>(e);
+      if (c.callee->kind != ExprKind::Name) return false;
+      const std::string key = canon(static_cast<const NameExpr&>(*c.callee).name.text);
+      if (lookup(key) || pous_.count(key)) return false;  // the program's own, whatever its name
+      static const std::set<std::string, std::less<>> kValueFunctions = {"SHL", "SHR", "ROL", "ROR", "MIN",
+                                                                         "MAX", "LIMIT", "MOVE"};
+      if (!kValueFunctions.count(key)) {
+        // A conversion between numbers, bit strings and BOOL (no BCD, no STRING, no units).
+        const std::optional<ConversionName> cn = parse_conversion(*tt_, key);
+        auto plain = [](const Type* t) { return t->is_numeric() || t->is_anybit(); };
+        if (!cn || !cn->to || cn->bcd != ConversionName::Bcd::None || cn->unit_ns != 0 || !plain(cn->to) ||
+            (cn->from && !plain(cn->from)))
+          return false;
+      }
+      for (const CallArg& a : c.args)
+        if (a.is_output || a.name || !a.value || !select_safe(*a.value, checked, depth + 1)) return false;
+      return !c.args.empty();
+    }
+    default: return plain_read_type(e, checked, depth) != nullptr;
+  }
+}
+
+namespace {
+// The one assignment `v := e` an arm consists of, when it is a plain one to a variable
+// named by itself (no element, member, REF=, S=/R=, chained or declaring form).
+const AssignStmt* single_assignment(const StmtList& body) {
+  if (body.size() != 1 || body[0]->kind != StmtKind::Assign) return nullptr;
+  const auto* a = static_cast<const AssignStmt*>(body[0].get());
+  if (a->is_ref_assign || a->set_reset || a->chained || a->declares_temp || a->lhs->kind != ExprKind::Name) return nullptr;
+  return a;
+}
+
+bool int_literal(const Expr& e, uint64_t* value) {
+  if (e.kind != ExprKind::Literal) return false;
+  const auto& l = static_cast<const LiteralExpr&>(e);
+  if (l.lit != LiteralKind::Int) return false;
+  *value = l.int_value;
+  return true;
+}
+}  // namespace
+
+// Rule 26 (chosen on the tuning half): an IF whose condition tests bits of data and whose
+// arms each assign the same variable, `IF (crc AND 16#8000) <> 0 THEN crc := SHL(crc, 1)
+// XOR 16#1021; ELSE crc := SHL(crc, 1); END_IF` or `IF flags[i] THEN w := w OR SHL(WORD#1,
+// k); END_IF`, evaluates both values and selects one (SEL1..SEL8): such bits are
+// data, a CRC's or a parity's or a flag array's, and a jump on them goes either way at
+// random (a mispredicted jump costs more than the few instructions of the other arm).
+// Comparisons of magnitudes (limits, state machine events, counters) and BOOL status
+// variables (an edge's Q, a limit switch) mostly go one way and keep their jump: selects
+// made the tuning kernels that have them slower. Applies when the arms only read
+// variables and cannot fail (select_safe), so evaluating the arm not taken cannot be
+// seen; the variable is a plain one of a type of 1, 2, 4 or 8 bytes without a subrange;
+// the condition is an element of a BOOL array or a bit of a word (w.3), NOT of one, or
+// (x AND K) or x MOD 2^k compared (= or <>) with 0; there is no ELSIF; and no coverage
+// is collected. The condition is evaluated once, as before.
+bool Compiler::select_if(const IfStmt& s) {
+  if (!opt_.if_selects || opt_.coverage || s.arms.size() != 1 || !s.arms[0].label.empty()) return false;
+  const auto& arm = s.arms[0];
+  const AssignStmt* yes = single_assignment(arm.body);
+  const AssignStmt* no = s.else_body ? single_assignment(*s.else_body) : nullptr;
+  if (!yes || (s.else_body && (!no || !same_expr(*yes->lhs, *no->lhs, 0)))) return false;
+  const Type* t = plain_read_type(*yes->lhs, nullptr, 0);
+  if (!t || !t->is_elementary() || t->is_string() || t->ranged || t->kind == TypeKind::Ref ||
+      (t->size != 1 && t->size != 2 && t->size != 4 && t->size != 8))
+    return false;
+  // x := x in an arm: ST401's warning is the assignment statement's.
+  auto self = [&](const AssignStmt* a) {
+    return a && a->rhs->kind == ExprKind::Name &&
+           iequals(static_cast<const NameExpr&>(*a->rhs).name.text, static_cast<const NameExpr&>(*a->lhs).name.text);
+  };
+  if (self(yes) || self(no)) return false;
+
+  // The condition, NOTs taken off: which form of bit test, if any.
+  const Expr* c = arm.cond.get();
+  bool when = true;  // the select takes `yes` when the test gives this
+  while (c->kind == ExprKind::Unary && static_cast<const UnaryExpr*>(c)->op == UnaryOp::Not) {
+    c = static_cast<const UnaryExpr*>(c)->operand.get();
+    when = !when;
+  }
+  const Expr* word = nullptr;  // (word AND 2^bit) <> 0, or word MOD 2 <> 0 (bit 0)
+  uint32_t bit = 0;
+  if (c->kind == ExprKind::Index || c->kind == ExprKind::BitAccess) {
+    const Type* ct = plain_read_type(*c, nullptr, 0);
+    if (!ct || ct->kind != TypeKind::Bool) return false;
+  } else if (c->kind == ExprKind::Binary) {
+    const auto& cmp = static_cast<const BinaryExpr&>(*c);
+    if (cmp.op != BinaryOp::Eq && cmp.op != BinaryOp::Ne) return false;
+    uint64_t zero = 1;
+    const Expr* tested = int_literal(*cmp.rhs, &zero) ? cmp.lhs.get() : int_literal(*cmp.lhs, &zero) ? cmp.rhs.get() : nullptr;
+    if (!tested || zero != 0 || tested->kind != ExprKind::Binary) return false;
+    const auto& m = static_cast<const BinaryExpr&>(*tested);
+    uint64_t k = 0;
+    if (m.op == BinaryOp::And) {
+      const Expr* x = int_literal(*m.rhs, &k) ? m.lhs.get() : int_literal(*m.lhs, &k) ? m.rhs.get() : nullptr;
+      if (!x || k == 0) return false;
+      if ((k & (k - 1)) == 0) word = x, bit = static_cast<uint32_t>(std::countr_zero(k));
+    } else if (m.op == BinaryOp::Mod) {
+      // x MOD 2^k is 0 exactly when the k low bits of x are (either sign, truncated MOD).
+      if (!int_literal(*m.rhs, &k) || k < 2 || (k & (k - 1)) != 0) return false;
+      if (k == 2) word = m.lhs.get(), bit = 0;
+    } else {
+      return false;
+    }
+    // "= 0": the bit clear (GETBIT below gives the bit; the comparison's own value needs no flip).
+    if (cmp.op == BinaryOp::Eq && word) when = !when;
+  } else {
+    return false;
+  }
+  // The arms are evaluated whether taken or not: each only reads and cannot fail (an
+  // element the condition reads is checked by then).
+  std::vector<const IndexExpr*> checked;
+  collect_indexes(*c, &checked, 0);
+  if (!select_safe(*yes->rhs, &checked, 0) || (no && !select_safe(*no->rhs, &checked, 0))) return false;
+
+  const uint32_t saved = b_->temp_top;
+  mark(arm.loc);
+  Slot test;
+  if (word) {
+    // One bit of the word: GETBIT (0 or 1), the test's "<> 0".
+    Val w = expr(*word);
+    if (!w.ok) return b_->temp_top = saved, true;
+    const Type* wt = w.type ? w.type : default_type(w.c);
+    if (!(wt->is_integer() || wt->is_bitstring()) || wt->ranged || bit >= wt->size * 8) {
+      // Not a word whose bit GETBIT reads: the comparison as a value.
+      const auto* cmp = static_cast<const BinaryExpr*>(c);
+      if (cmp->op == BinaryOp::Eq) when = !when;  // undo the flip for GETBIT's bit
+      Val v = expr(*c, elem(TypeKind::Bool));
+      if (!v.ok) return b_->temp_top = saved, true;
+      test = to_slot(v, elem(TypeKind::Bool), arm.cond->loc);
+    } else {
+      Slot ws = to_slot(w, wt, word->loc);
+      test = temp(1, 1);
+      const uint32_t n = wt->size;
+      emit(n == 1 ? Op::GETBIT1 : n == 2 ? Op::GETBIT2 : n == 4 ? Op::GETBIT4 : Op::GETBIT8, {test, ws, bit});
+    }
+  } else {
+    Val v = expr(*c, elem(TypeKind::Bool));
+    if (!v.ok) return b_->temp_top = saved, true;
+    if (!v.type || v.type->kind != TypeKind::Bool) {
+      diags_.error("ST205", c->loc, "a condition must be BOOL, not " + tname(v.type));
+      return b_->temp_top = saved, true;
+    }
+    test = to_slot(v, elem(TypeKind::Bool), c->loc);
+  }
+  // The arms' coverage ids as the jumps would have them (no COV: no coverage here).
+  uint32_t decision = kNoBranch;
+  branch(arm.loc, "IF", s.loc, &decision, arm.body);
+  if (s.else_body) branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE", s.loc, &decision, *s.else_body);
+  auto value = [&](const Expr& e, SourceLoc loc) -> std::optional<Slot> {
+    Val v = expr_for(e, t);
+    if (!v.ok) return std::nullopt;
+    Val cv = coerce(v, t, loc, "assignment");
+    if (!cv.ok) return std::nullopt;
+    return to_slot(cv, t, loc);
+  };
+  mark(yes->loc);
+  std::optional<Slot> a = value(*yes->rhs, yes->loc);
+  if (no) mark(no->loc);
+  std::optional<Slot> b = no ? value(*no->rhs, no->loc) : value(*yes->lhs, yes->loc);
+  if (!a || !b) return b_->temp_top = saved, true;
+  Slot d = temp_for(t);
+  emit(sel_op(t->size), {d, test, when ? *a : *b, when ? *b : *a});
+  def(d, 1);
+  Val chosen;
+  chosen.type = t;
+  chosen.slot = d;
+  Place dst = place(*yes->lhs, true);
+  assign(dst, chosen, yes->loc);
+  b_->temp_top = saved;
+  b_->cvt_cache.clear();
+  app_->if_selects = true;
+  return true;
+}
+
 void Compiler::if_stmt(const IfStmt& s) {
+  if (select_if(s)) return;
   Label end = new_label();
   uint32_t decision = kNoBranch;
   for (size_t i = 0; i < s.arms.size(); ++i) {

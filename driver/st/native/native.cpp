@@ -360,7 +360,7 @@ class Translator {
     switch (op) {
       case Op::NOP: case Op::RET: case Op::JMP: case Op::JMPF: case Op::JMPT: case Op::JTAB: case Op::COV:
       case Op::FBENTER: case Op::FNMOCK: case Op::FRAME: case Op::CALL: case Op::CALLA: case Op::CALLS:
-      case Op::MOV1: case Op::MOV2: case Op::MOV4: case Op::MOV8: case Op::MOVN:
+      case Op::MOV1: case Op::MOV2: case Op::MOV4: case Op::MOV8: case Op::SEL1: case Op::SEL2: case Op::SEL4: case Op::SEL8: case Op::MOVN:
       case Op::LDG1: case Op::LDG2: case Op::LDG4: case Op::LDG8: case Op::LDGN:
       case Op::STG1: case Op::STG2: case Op::STG4: case Op::STG8: case Op::STGN:
       case Op::LDBIT: case Op::STBIT: case Op::ADDR: case Op::ADDRK: case Op::INITBLK: case Op::NOW: case Op::ADVTIME:
@@ -834,6 +834,11 @@ class Translator {
       case Op::MOV2: s = W("uint16_t", 1, R("uint16_t", 2)); return true;
       case Op::MOV4: s = W("uint32_t", 1, R("uint32_t", 2)); return true;
       case Op::MOV8: s = W("uint64_t", 1, R("uint64_t", 2)); return true;
+      case Op::SEL1: case Op::SEL2: case Op::SEL4: case Op::SEL8: {
+        const char* t = op == Op::SEL1 ? "uint8_t" : op == Op::SEL2 ? "uint16_t" : op == Op::SEL4 ? "uint32_t" : "uint64_t";
+        s = W(t, 1, fmt::format("({} != 0 ? {} : {})", R("uint8_t", 2), R(t, 3), R(t, 4)));
+        return true;
+      }
       case Op::MOVN: s = fmt::format("std::{}(base + {}, base + {}, {});", copy_fn(w[1], w[2], w[3]), K(1), K(2), K(3)); return true;
       case Op::LDG1: s = W("uint8_t", 1, fmt::format("ld<uint8_t>({})", G(2))); return true;
       case Op::LDG2: s = W("uint16_t", 1, fmt::format("ld<uint16_t>({})", G(2))); return true;
@@ -1162,7 +1167,7 @@ class Translator {
       // Writes only through W, or none at all.
       case Op::NOP: case Op::HALT: case Op::RET: case Op::JMP: case Op::JMPB: case Op::JMPF: case Op::JMPT: case Op::JTAB:
       case Op::COV: case Op::FNMOCK: case Op::TRAP: case Op::FRAME: case Op::ENTER:
-      case Op::MOV1: case Op::MOV2: case Op::MOV4: case Op::MOV8:
+      case Op::MOV1: case Op::MOV2: case Op::MOV4: case Op::MOV8: case Op::SEL1: case Op::SEL2: case Op::SEL4: case Op::SEL8:
       case Op::LDG1: case Op::LDG2: case Op::LDG4: case Op::LDG8:
       case Op::LDI1: case Op::LDI2: case Op::LDI4: case Op::LDI8:
       case Op::LDBIT: case Op::ADDR: case Op::ADDRI: case Op::ADDRK: case Op::ELEM: case Op::NOW: case Op::ADVTIME:
@@ -1335,7 +1340,7 @@ class Translator {
     switch (op) {
       case Op::NOP: case Op::HALT: case Op::RET: case Op::JMP: case Op::JMPB: case Op::JMPF: case Op::JMPT: case Op::JTAB:
       case Op::COV: case Op::TRAP: case Op::FRAME: case Op::ENTER:
-      case Op::MOV1: case Op::MOV2: case Op::MOV4: case Op::MOV8:
+      case Op::MOV1: case Op::MOV2: case Op::MOV4: case Op::MOV8: case Op::SEL1: case Op::SEL2: case Op::SEL4: case Op::SEL8:
       case Op::LDG1: case Op::LDG2: case Op::LDG4: case Op::LDG8: case Op::STG1: case Op::STG2: case Op::STG4: case Op::STG8:
       case Op::LDI1: case Op::LDI2: case Op::LDI4: case Op::LDI8: case Op::STI1: case Op::STI2: case Op::STI4: case Op::STI8:
       case Op::LDBIT: case Op::STBIT: case Op::ADDR: case Op::ADDRI: case Op::ADDRK: case Op::ELEM: case Op::NOW: case Op::ADVTIME:

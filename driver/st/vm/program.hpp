@@ -217,6 +217,9 @@ class Application {
   // Some assignment is compiled more than once, copied into the arms of an IF or CASE
   // before a loop's bottom (CompileOptions::loop_tails): mutation analysis needs one store.
   bool copied_statements = false;
+  // Some IF is a select instruction, not a jump (CompileOptions::if_selects): mutation
+  // analysis needs the jump.
+  bool if_selects = false;
   // FB_init/FB_exit (CODESYS): a routine over every program instance and global instance,
   // run by Machine::cold_restart/warm_restart on the frame at lifecycle_addr.
   // The byte at init_flag_addr is what FB_init gets as bInitRetains.

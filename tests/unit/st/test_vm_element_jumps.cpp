@@ -17,10 +17,12 @@ namespace plcfi::st {
 namespace {
 
 // Compiled as `plcfi run` compiles without --coverage: no COV after a jump (a jump and
-// the COV after it are a superinstruction of their own, to which these rules yield).
+// the COV after it are a superinstruction of their own, to which these rules yield); the
+// IFs on BOOL elements and on bits keep their jumps (rule 26 would make them selects).
 CompileOptions no_coverage() {
   CompileOptions o;
   o.coverage = false;
+  o.if_selects = false;
   return o;
 }
 
