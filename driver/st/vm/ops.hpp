@@ -46,6 +46,26 @@ inline void move_block(uint8_t* dst, const uint8_t* src, size_t n) {
   }
 }
 
+// move_block for a structure element of an array (LDXB, STXB): 9 to 15 bytes go as 8
+// bytes and the rest in pieces of 4, 2 and 1 that do not overlap. An element stored this
+// way and read back soon this way (an insertion sort's shifts; a temporary copied back)
+// is forwarded from the store buffer piece by piece, where move_block's two overlapping
+// 8-byte pieces (bytes 0-7 and 4-11 of 12) make each read wait for both stores to reach
+// the cache. struct_sort: -6 % in time; elsewhere move_block's fewer branches win.
+inline void move_element(uint8_t* dst, const uint8_t* src, size_t n) {
+  if (n <= 8 || n >= 16) return move_block(dst, src, n);
+  const size_t r = n - 8;
+  // Every load before the first store: the two may overlap.
+  const uint64_t head = ld<uint64_t>(src);
+  const uint32_t w4 = (r & 4) ? ld<uint32_t>(src + 8) : 0;
+  const uint16_t w2 = (r & 2) ? ld<uint16_t>(src + 8 + (r & 4)) : 0;
+  const uint8_t w1 = (r & 1) ? src[8 + (r & 6)] : 0;
+  st<uint64_t>(dst, head);
+  if (r & 4) st<uint32_t>(dst + 8, w4);
+  if (r & 2) st<uint16_t>(dst + 8 + (r & 4), w2);
+  if (r & 1) dst[8 + (r & 6)] = w1;
+}
+
 __extension__ typedef unsigned __int128 U128;  // one MUL on x86-64 and AArch64
 
 // Two's-complement wraparound without undefined behaviour (IEC integer overflow wraps).

@@ -1202,12 +1202,12 @@ L_TRUNC_F64: W(double, 1, std::trunc(R(double, 2))); NEXT(2);
   // Whole elements of structure arrays, copied as blocks (move_block, as LDIN/STIN do).
 L_LDXB: {
   ELEM_INDEX2(i, 3)
-  move_block(base + pc[1], base + pc[2] + i * pc[6] + pc[7], pc[8]);
+  move_element(base + pc[1], base + pc[2] + i * pc[6] + pc[7], pc[8]);
   NEXT(8);
 }
 L_STXB: {
   ELEM_INDEX2(i, 2)
-  move_block(base + pc[1] + i * pc[5] + pc[6], base + pc[7], pc[8]);
+  move_element(base + pc[1] + i * pc[5] + pc[6], base + pc[7], pc[8]);
   NEXT(8);
 }
 #undef ELEM_INDEX2
@@ -1378,11 +1378,11 @@ L_EB_LDXB_STXB: {
   ELEM_INDEX_AS(i, int32_t, 3)
   const uint8_t* const from = base + pc[2] + i * pc[6] + pc[7];
   const uint32_t size = pc[8];
-  move_block(base + pc[1], from, size);
+  move_element(base + pc[1], from, size);
   pc += 9;
   if (pc[8] != size) goto L_STXB;  // not the block the LDXB loaded: the plain STXB
   ELEM_INDEX_AS(j, int32_t, 2)
-  move_block(base + pc[1] + j * pc[5] + pc[6], from, size);
+  move_element(base + pc[1] + j * pc[5] + pc[6], from, size);
   NEXT(8);
 }
   // A reduction loop as a whole (find_reductions, run_reduction).

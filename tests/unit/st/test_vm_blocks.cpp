@@ -18,7 +18,7 @@
 namespace plcfi::st {
 namespace {
 
-TEST(VmBlocks, MoveBlockIsMemmoveForEverySizeAndOverlap) {
+TEST(VmBlocks, MoveBlockAndMoveElementAreMemmoveForEverySizeAndOverlap) {
   constexpr int kSpan = 96;
   for (size_t n = 0; n <= 40; ++n) {
     for (int from = 0; from + static_cast<int>(n) <= kSpan; from += 3) {
@@ -29,6 +29,10 @@ TEST(VmBlocks, MoveBlockIsMemmoveForEverySizeAndOverlap) {
         std::memmove(want.data() + to, want.data() + from, n);
         ops::move_block(got.data() + to, got.data() + from, n);
         ASSERT_EQ(want, got) << "n " << n << " from " << from << " to " << to;
+        // The structure elements' copy (pieces that do not overlap) gives the same.
+        std::iota(got.begin(), got.end(), uint8_t{1});
+        ops::move_element(got.data() + to, got.data() + from, n);
+        ASSERT_EQ(want, got) << "move_element: n " << n << " from " << from << " to " << to;
       }
     }
   }
