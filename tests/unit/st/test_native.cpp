@@ -98,7 +98,8 @@ TEST(NativeTier, BenchKernelsScanLikeTheInterpreter) {
 // structs, timers and edges. The same memory outside compiler temporaries after every scan.
 TEST(NativeTier, Matiec31KernelsScanLikeTheInterpreter) {
   for (const char* k : {"crc16_parity", "bitpack", "str_build", "real_ctrl", "enum_fsm", "int_nested", "struct_sort", "crc32",
-                        "str_parse", "ring_filter", "fb_timers", "int_while", "struct_search"}) {
+                        "str_parse", "ring_filter", "fb_timers", "int_while", "struct_search", "int_sieve",
+                        "struct_queue"}) {
     SCOPED_TRACE(k);
     std::string file = std::string(k) + ".st";
     Pair p = build_both({{file, read_file(std::string(PLCFI_SOURCE_DIR) + "/tests/bench/matiec31/" + file)}});
