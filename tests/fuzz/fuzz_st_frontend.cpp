@@ -1,7 +1,8 @@
 // Fuzz target: the ST front end (lexer, parser, semantic checks, bytecode compiler) on one
 // source; a program that compiles restarts (FB_init) and runs a few scans under a small VM
 // budget (the watchdog). A source that holds the comment `(* dialect: codesys *)` is
-// compiled as CODESYS ST (the seeds of CODESYS constructs carry it), any other as IEC.
+// compiled as CODESYS ST (the seeds of CODESYS constructs carry it), any other as IEC;
+// one of odd length without coverage marks.
 #include <cstdint>
 #include <string>
 
@@ -21,6 +22,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace plcfi;
   st::CompileOptions opt;
   opt.warnings = true;
+  // Sources of odd length compile as `plcfi run` compiles without --coverage (IFs on
+  // bits as selects, jumps without coverage marks); of even length with the marks.
+  opt.coverage = size % 2 == 0;
   std::string text(fuzz::as_text(data, size));
   if (text.find("(* dialect: codesys *)") != std::string::npos) opt.dialect = st::Dialect::Codesys;
   auto b = st::build_sources({{"fuzz.st", std::move(text)}}, opt);

@@ -922,10 +922,15 @@ bool Compiler::select_if(const IfStmt& s) {
 
   const uint32_t saved = b_->temp_top;
   mark(arm.loc);
+  const size_t code_before = b_->code.size();
+  // A constant condition (nothing emitted for it) is left to the jumps, which fold it
+  // and warn (ST404).
+  auto constant = [&](const Val& v) { return v.ok && v.is_const && b_->code.size() == code_before; };
   Slot test;
   if (word) {
     // One bit of the word: GETBIT (0 or 1), the test's "<> 0".
     Val w = expr(*word);
+    if (constant(w)) return b_->temp_top = saved, false;
     if (!w.ok) return b_->temp_top = saved, true;
     const Type* wt = w.type ? w.type : default_type(w.c);
     if (!(wt->is_integer() || wt->is_bitstring()) || wt->ranged || bit >= wt->size * 8) {
@@ -933,6 +938,7 @@ bool Compiler::select_if(const IfStmt& s) {
       const auto* cmp = static_cast<const BinaryExpr*>(c);
       if (cmp->op == BinaryOp::Eq) when = !when;  // undo the flip for GETBIT's bit
       Val v = expr(*c, elem(TypeKind::Bool));
+      if (constant(v)) return b_->temp_top = saved, false;
       if (!v.ok) return b_->temp_top = saved, true;
       test = to_slot(v, elem(TypeKind::Bool), arm.cond->loc);
     } else {
@@ -943,6 +949,7 @@ bool Compiler::select_if(const IfStmt& s) {
     }
   } else {
     Val v = expr(*c, elem(TypeKind::Bool));
+    if (constant(v)) return b_->temp_top = saved, false;
     if (!v.ok) return b_->temp_top = saved, true;
     if (!v.type || v.type->kind != TypeKind::Bool) {
       diags_.error("ST205", c->loc, "a condition must be BOOL, not " + tname(v.type));

@@ -57,7 +57,10 @@ std::string read_kernel(const std::string& name) {
   return ss.str();
 }
 
-enum class Tier { Interpreter, Native };
+// Interpreter and Native: compiled with coverage marks (the default options); Run: as
+// `plcfi run` compiles without --coverage (selects for IFs on bits, rule 26), in the
+// interpreter.
+enum class Tier { Interpreter, Native, Run };
 
 struct Param {
   const char* kernel;
@@ -66,11 +69,13 @@ struct Param {
 
 // gtest prints a parameter's bytes otherwise (and ctest shows them beside the test's name).
 void PrintTo(const Param& p, std::ostream* os) {
-  *os << p.kernel << (p.tier == Tier::Interpreter ? " in the interpreter" : " in the native tier");
+  *os << p.kernel
+      << (p.tier == Tier::Interpreter ? " in the interpreter" : p.tier == Tier::Native ? " in the native tier" : " as plcfi run compiles it");
 }
 
 std::string param_name(const ::testing::TestParamInfo<Param>& p) {
-  return std::string(p.param.tier == Tier::Interpreter ? "interp_" : "native_") + p.param.kernel;
+  return std::string(p.param.tier == Tier::Interpreter ? "interp_" : p.param.tier == Tier::Native ? "native_" : "run_") +
+         p.param.kernel;
 }
 
 class MatiecState : public ::testing::TestWithParam<Param> {};
@@ -116,7 +121,9 @@ TEST_P(MatiecState, ReproducesTheRecordedState) {
   const std::string source = read_kernel(p.kernel);
   ASSERT_FALSE(source.empty()) << "cannot read " << PLCFI_MATIEC_KERNEL_DIR << "/" << p.kernel << ".st";
 
-  auto b = build_sources({{std::string(p.kernel) + ".st", source}}, CompileOptions{});
+  CompileOptions options;
+  options.coverage = p.tier != Tier::Run;
+  auto b = build_sources({{std::string(p.kernel) + ".st", source}}, options);
   ASSERT_TRUE(b->ok()) << b->diags.render_all();
   const Application& app = *b->app;
   const ProgramInstance* inst = nullptr;
@@ -136,7 +143,7 @@ TEST_P(MatiecState, ReproducesTheRecordedState) {
     m.set_native(native.get());
   }
 
-  const int limit = kUnderAsan && p.tier == Tier::Interpreter ? 1000 : 100000;
+  const int limit = kUnderAsan && p.tier != Tier::Native ? 1000 : 100000;
   int done = 0;
   for (const mk::ExpectedState& es : ki->states) {
     if (es.scans > limit) continue;
@@ -158,7 +165,10 @@ INSTANTIATE_TEST_SUITE_P(
                       Param{"arrays", Tier::Interpreter}, Param{"arrays", Tier::Native},
                       Param{"fbcalls", Tier::Interpreter}, Param{"fbcalls", Tier::Native},
                       Param{"nested_fbs", Tier::Interpreter}, Param{"nested_fbs", Tier::Native},
-                      Param{"crc16", Tier::Interpreter}, Param{"crc16", Tier::Native}),
+                      Param{"crc16", Tier::Interpreter}, Param{"crc16", Tier::Native},
+                      Param{"statemachine", Tier::Run}, Param{"intloop", Tier::Run}, Param{"realmath", Tier::Run},
+                      Param{"arrays", Tier::Run}, Param{"fbcalls", Tier::Run}, Param{"nested_fbs", Tier::Run},
+                      Param{"crc16", Tier::Run}),
     param_name);
 
 // Every kernel in the table has a test above, and every state lists at least a checksum.

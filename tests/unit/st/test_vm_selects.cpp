@@ -303,6 +303,7 @@ TEST(VmSelects, OtherIfsKeepTheirJump) {
       "IF n MOD 3 = 0 THEN x := 1; END_IF;",
       "IF a AND b THEN x := 1; END_IF;",
       "IF a THEN x := x + 1; END_IF;",
+      "IF (5 AND 1) <> 0 THEN x := 1; ELSE x := 2; END_IF;",
       "IF NOT a THEN x := 1; ELSE x := 2; END_IF;",
   };
   for (const char* body : kept) {
@@ -313,6 +314,10 @@ TEST(VmSelects, OtherIfsKeepTheirJump) {
     ASSERT_TRUE(p.ok()) << body;
     EXPECT_FALSE(p.b->app->if_selects) << body;
     ASSERT_TRUE(p.scan()) << body;
+    // A constant condition is still folded and warned about, as with jumps.
+    if (std::string(body).find("(5 AND 1)") != std::string::npos) {
+      EXPECT_NE(p.b->diags.render_all().find("ST404"), std::string::npos) << p.b->diags.render_all();
+    }
   }
 }
 
