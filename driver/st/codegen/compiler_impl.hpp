@@ -365,6 +365,8 @@ class Compiler {
   // fail, compiled as a select (CompileOptions::if_selects; see stmt.cpp). False:
   // nothing emitted, the IF is compiled with jumps.
   bool select_if(const IfStmt& s);
+  // The comparison of one bit with 0 just emitted as a value, as one GETBIT (see stmt.cpp).
+  std::optional<Slot> single_bit(bool* inverted);
   // Whether evaluating e only reads variables, calls standard functions that compute a
   // value from their inputs (shifts, MIN, MAX, LIMIT, MOVE, numeric conversions) and
   // cannot fail (the rules of plain_read_type).

@@ -861,6 +861,65 @@ bool int_literal(const Expr& e, uint64_t* value) {
 // the condition is an element of a BOOL array or a bit of a word (w.3), NOT of one, or
 // (x AND K) or x MOD 2^k compared (= or <>) with 0; there is no ELSIF; and no coverage
 // is collected. The condition is evaluated once, as before.
+// A comparison of one bit with 0 that was just emitted as a value, "AND t, x, m; EQ/NE
+// c, t, 0" with a single-bit constant m (either operand order) or "MODK t, x, .., 2;
+// EQ/NE c, t, 0", in the same line and block, t read by the comparison only: replaced by
+// one GETBIT of x, the bit (set: the "<> 0"; *inverted for "= 0"). Nullopt: nothing changed.
+std::optional<Slot> Compiler::single_bit(bool* inverted) {
+  auto& code = b_->code;
+  const uint32_t cmp_at = b_->last_instr, op_at = b_->prev_instr;
+  if (cmp_at >= code.size() || op_at == UINT32_MAX || op_at >= cmp_at || op_at < b_->last_label_pos ||
+      cmp_at + 4 != code.size())
+    return std::nullopt;
+  if (!b_->lines.empty() && b_->lines.back().first > op_at) return std::nullopt;
+  constexpr uint32_t num_stride = static_cast<uint32_t>(Op::ADD_I16) - static_cast<uint32_t>(Op::ADD_I8);
+  constexpr uint32_t int_stride = static_cast<uint32_t>(Op::MOD_I16) - static_cast<uint32_t>(Op::MOD_I8);
+  static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8};
+  uint32_t ti = 8;
+  bool eq = false;
+  for (uint32_t k = 0; k < 8; ++k) {
+    if (code[cmp_at] == static_cast<uint32_t>(Op::EQ_I8) + k * num_stride) ti = k, eq = true;
+    if (code[cmp_at] == static_cast<uint32_t>(Op::NE_I8) + k * num_stride) ti = k;
+  }
+  if (ti == 8) return std::nullopt;
+  // The comparison reads the temporary op_at defined and a constant 0.
+  const uint32_t t = code[op_at + 1];
+  if (kind_at(op_at + 1) != SK::Temp) return std::nullopt;
+  auto zero = [&](uint32_t word) { return const_at(word, kWidth[ti]) == uint64_t{0}; };
+  auto is_t = [&](uint32_t word) { return code[word] == t && kind_at(word) == SK::Temp; };
+  if (!(is_t(cmp_at + 2) && zero(cmp_at + 3)) && !(is_t(cmp_at + 3) && zero(cmp_at + 2))) return std::nullopt;
+  uint32_t bit = 0;
+  bool x_second = false;  // AND's x is its second operand (the mask the first)
+  const uint32_t op = code[op_at];
+  if (op == static_cast<uint32_t>(Op::AND_I8) + ti * int_stride && op_at + 4 == cmp_at) {
+    auto single = [&](uint32_t word) -> std::optional<uint32_t> {
+      std::optional<uint64_t> m = const_at(word, kWidth[ti]);
+      if (!m || *m == 0 || (*m & (*m - 1)) != 0) return std::nullopt;
+      return static_cast<uint32_t>(std::countr_zero(*m));
+    };
+    if (std::optional<uint32_t> b = single(op_at + 3)) bit = *b;
+    else if (std::optional<uint32_t> b2 = single(op_at + 2)) bit = *b2, x_second = true;
+    else return std::nullopt;
+  } else if ((op == static_cast<uint32_t>(Op::MODK_I32) && ti == 2) || (op == static_cast<uint32_t>(Op::MODK_I16) && ti == 1)) {
+    if (op_at + 6 != cmp_at || code[op_at + 5] != 2) return std::nullopt;
+    bit = 0;  // x MOD 2 <> 0: bit 0 set, whatever the sign
+  } else {
+    return std::nullopt;
+  }
+  auto [a, b] = unemit(op_at);
+  const Arg x = x_second ? b : a;
+  // The bit goes where the AND's (or MODK's) result went, and the comparison's
+  // temporary, allocated after it, is free again: the temporaries after it are placed as
+  // after a GETBIT of the word written out.
+  const Slot d{t, SK::Temp};
+  b_->temp_top = t + 1;
+  const uint32_t n = kWidth[ti];
+  emit(n == 1 ? Op::GETBIT1 : n == 2 ? Op::GETBIT2 : n == 4 ? Op::GETBIT4 : Op::GETBIT8, {d, x, bit});
+  def(d);
+  *inverted = eq;
+  return d;
+}
+
 bool Compiler::select_if(const IfStmt& s) {
   if (!opt_.if_selects || opt_.coverage || s.arms.size() != 1 || !s.arms[0].label.empty()) return false;
   const auto& arm = s.arms[0];
@@ -885,8 +944,6 @@ bool Compiler::select_if(const IfStmt& s) {
     c = static_cast<const UnaryExpr*>(c)->operand.get();
     when = !when;
   }
-  const Expr* word = nullptr;  // (word AND 2^bit) <> 0, or word MOD 2 <> 0 (bit 0)
-  uint32_t bit = 0;
   if (c->kind == ExprKind::Index || c->kind == ExprKind::BitAccess) {
     const Type* ct = plain_read_type(*c, nullptr, 0);
     if (!ct || ct->kind != TypeKind::Bool) return false;
@@ -899,18 +956,13 @@ bool Compiler::select_if(const IfStmt& s) {
     const auto& m = static_cast<const BinaryExpr&>(*tested);
     uint64_t k = 0;
     if (m.op == BinaryOp::And) {
-      const Expr* x = int_literal(*m.rhs, &k) ? m.lhs.get() : int_literal(*m.lhs, &k) ? m.rhs.get() : nullptr;
-      if (!x || k == 0) return false;
-      if ((k & (k - 1)) == 0) word = x, bit = static_cast<uint32_t>(std::countr_zero(k));
+      if (!int_literal(*m.rhs, &k) && !int_literal(*m.lhs, &k)) return false;
     } else if (m.op == BinaryOp::Mod) {
       // x MOD 2^k is 0 exactly when the k low bits of x are (either sign, truncated MOD).
       if (!int_literal(*m.rhs, &k) || k < 2 || (k & (k - 1)) != 0) return false;
-      if (k == 2) word = m.lhs.get(), bit = 0;
     } else {
       return false;
     }
-    // "= 0": the bit clear (GETBIT below gives the bit; the comparison's own value needs no flip).
-    if (cmp.op == BinaryOp::Eq && word) when = !when;
   } else {
     return false;
   }
@@ -923,39 +975,21 @@ bool Compiler::select_if(const IfStmt& s) {
   const uint32_t saved = b_->temp_top;
   mark(arm.loc);
   const size_t code_before = b_->code.size();
-  // A constant condition (nothing emitted for it) is left to the jumps, which fold it
-  // and warn (ST404).
-  auto constant = [&](const Val& v) { return v.ok && v.is_const && b_->code.size() == code_before; };
-  Slot test;
-  if (word) {
-    // One bit of the word: GETBIT (0 or 1), the test's "<> 0".
-    Val w = expr(*word);
-    if (constant(w)) return b_->temp_top = saved, false;
-    if (!w.ok) return b_->temp_top = saved, true;
-    const Type* wt = w.type ? w.type : default_type(w.c);
-    if (!(wt->is_integer() || wt->is_bitstring()) || wt->ranged || bit >= wt->size * 8) {
-      // Not a word whose bit GETBIT reads: the comparison as a value.
-      const auto* cmp = static_cast<const BinaryExpr*>(c);
-      if (cmp->op == BinaryOp::Eq) when = !when;  // undo the flip for GETBIT's bit
-      Val v = expr(*c, elem(TypeKind::Bool));
-      if (constant(v)) return b_->temp_top = saved, false;
-      if (!v.ok) return b_->temp_top = saved, true;
-      test = to_slot(v, elem(TypeKind::Bool), arm.cond->loc);
-    } else {
-      Slot ws = to_slot(w, wt, word->loc);
-      test = temp(1, 1);
-      const uint32_t n = wt->size;
-      emit(n == 1 ? Op::GETBIT1 : n == 2 ? Op::GETBIT2 : n == 4 ? Op::GETBIT4 : Op::GETBIT8, {test, ws, bit});
-    }
-  } else {
-    Val v = expr(*c, elem(TypeKind::Bool));
-    if (constant(v)) return b_->temp_top = saved, false;
-    if (!v.ok) return b_->temp_top = saved, true;
-    if (!v.type || v.type->kind != TypeKind::Bool) {
-      diags_.error("ST205", c->loc, "a condition must be BOOL, not " + tname(v.type));
-      return b_->temp_top = saved, true;
-    }
-    test = to_slot(v, elem(TypeKind::Bool), c->loc);
+  // The condition as a value, compiled (and type-checked) as any BOOL expression; a
+  // constant one (nothing emitted) is left to the jumps, which fold it and warn (ST404).
+  Val cond_value = expr(*c, elem(TypeKind::Bool));
+  if (cond_value.ok && cond_value.is_const && b_->code.size() == code_before) return b_->temp_top = saved, false;
+  if (!cond_value.ok) return b_->temp_top = saved, true;
+  if (!cond_value.type || cond_value.type->kind != TypeKind::Bool) {
+    diags_.error("ST205", c->loc, "a condition must be BOOL, not " + tname(cond_value.type));
+    return b_->temp_top = saved, true;
+  }
+  Slot test = to_slot(cond_value, elem(TypeKind::Bool), c->loc);
+  // One bit tested: GETBIT instead of the AND (or MOD 2) and the comparison.
+  bool inverted = false;
+  if (std::optional<Slot> bit = single_bit(&inverted)) {
+    test = *bit;
+    if (inverted) when = !when;
   }
   // The arms' coverage ids as the jumps would have them (no COV: no coverage here).
   uint32_t decision = kNoBranch;

@@ -321,6 +321,25 @@ TEST(VmSelects, OtherIfsKeepTheirJump) {
   }
 }
 
+TEST(VmSelects, ATestOfBitsIsTypeCheckedAsWithJumps) {
+  // 16#8000 does not fit INT, 16#80 not SINT: an error either way, never a select of bit
+  // 15 or 7 that `plcfi run` would accept and `plcfi check` refuse.
+  const char* src = R"(
+PROGRAM P
+  VAR s : INT := -5; n : SINT := -3; x : DINT; END_VAR
+  IF (s AND 16#8000) <> 0 THEN x := 1; ELSE x := 2; END_IF;
+  IF (n AND 16#80) = 0 THEN x := x + 10; END_IF;
+END_PROGRAM
+)";
+  for (bool on : {true, false}) {
+    auto b = build_sources({{"typed.st", src}}, selects(on));
+    EXPECT_FALSE(b->ok());
+    const std::string d = b->diags.render_all();
+    EXPECT_NE(d.find("constant 32768 does not fit INT"), std::string::npos) << d;
+    EXPECT_NE(d.find("constant 128 does not fit SINT"), std::string::npos) << d;
+  }
+}
+
 TEST(VmSelects, ASubrangeTargetKeepsItsJump) {
   // `(w AND 1) <> 0` holds: x gets lim - 2. `(w AND 2) <> 0` does not: lim, a subrange
   // variable, keeps its jump and is not assigned 99 (which would trap).
