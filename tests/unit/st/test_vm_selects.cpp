@@ -247,42 +247,42 @@ END_PROGRAM
   EXPECT_EQ(calls, 0);
   EXPECT_FALSE(selected);
 
-  const char* divide = R"(
-PROGRAM P
-  VAR w : WORD := 16#0002; x : DINT := 10; z : DINT := 0; calls : DINT; END_VAR
-  IF (w AND 1) <> 0 THEN x := x / z; ELSE x := x MOD 7; END_IF;
-END_PROGRAM
-)";
-  EXPECT_EQ(trap_of(divide, nullptr, &selected), "");
-  EXPECT_FALSE(selected);
-
-  const char* index = R"(
-PROGRAM P
-  VAR flags : ARRAY [0..3] OF BOOL; v : ARRAY [0..3] OF DINT; j : DINT := 9; x : DINT; calls : DINT; END_VAR
-  IF flags[1] THEN x := v[j]; END_IF;
-END_PROGRAM
-)";
-  EXPECT_EQ(trap_of(index, nullptr, &selected), "");
-  EXPECT_FALSE(selected);
-
-  // The element the condition read (and checked) may be read again by an arm.
-  const char* checked = R"(
-PROGRAM P
-  VAR flags : ARRAY [0..3] OF BOOL := [FALSE, TRUE]; j : DINT := 1; x : DINT; calls : DINT; END_VAR
-  IF flags[j] THEN x := BOOL_TO_DINT(flags[j]) + 4; END_IF;
-END_PROGRAM
-)";
-  EXPECT_EQ(trap_of(checked, nullptr, &selected), "");
-  EXPECT_TRUE(selected);
-
-  // A condition that traps traps as before.
-  const char* bad = R"(
-PROGRAM P
-  VAR flags : ARRAY [0..3] OF BOOL; j : DINT := 4; x : DINT; calls : DINT; END_VAR
-  IF flags[j] THEN x := x + 1; END_IF;
-END_PROGRAM
-)";
-  EXPECT_NE(trap_of(bad).find("index 4 outside 0..3"), std::string::npos);
+  // One program each: its declarations, its IF, the trap one scan ends with ("" none)
+  // and whether the IF is a select.
+  struct Case {
+    const char* vars;
+    const char* stmt;
+    const char* trap;
+    bool select;
+  };
+  const Case cases[] = {
+      // a division by a variable that is zero, in the arm not taken
+      {"w : WORD := 16#0002; x : DINT := 10; z : DINT := 0;",
+       "IF (w AND 1) <> 0 THEN x := x / z; ELSE x := x MOD 7; END_IF;", "", false},
+      // an index nobody checked (9), in the arm not taken
+      {"flags : ARRAY [0..3] OF BOOL; v : ARRAY [0..3] OF DINT; j : DINT := 9; x : DINT;",
+       "IF flags[1] THEN x := v[j]; END_IF;", "", false},
+      // the element the condition read (and checked) read again by an arm
+      {"flags : ARRAY [0..3] OF BOOL := [FALSE, TRUE]; j : DINT := 1; x : DINT;",
+       "IF flags[j] THEN x := BOOL_TO_DINT(flags[j]) + 4; END_IF;", "", true},
+      // a condition that traps traps as before
+      {"flags : ARRAY [0..3] OF BOOL; j : DINT := 4; x : DINT;", "IF flags[j] THEN x := x + 1; END_IF;",
+       "index 4 outside 0..3", true},
+  };
+  for (const Case& c : cases) {
+    const std::string src = std::string("PROGRAM P\n  VAR ") + c.vars + " calls : DINT; END_VAR\n  " + c.stmt + "\nEND_PROGRAM\n";
+    VmRun p(src, selects(true), "keep.st");
+    ASSERT_TRUE(p.ok()) << c.stmt;
+    const bool ok = p.scan();
+    const std::string trap = ok ? "" : p.m->trap().message;
+    if (*c.trap) {
+      EXPECT_NE(trap.find(c.trap), std::string::npos) << c.stmt << ": " << trap;
+    } else {
+      EXPECT_EQ(trap, "") << c.stmt;
+    }
+    // A condition that traps ends the scan before the select: the listing tells.
+    EXPECT_EQ(occurrences(p.disasm(), " SEL4 ") == 1, c.select) << c.stmt;
+  }
 }
 
 TEST(VmSelects, OtherIfsKeepTheirJump) {
