@@ -608,6 +608,11 @@ bool test_compile_options(const po::variables_map& vm, st::CompileOptions* opt) 
   if (!tcunit_params(vm, &opt->tcunit_params)) return false;
   opt->test_mode = true;
   opt->warnings = false;
+  // As `run`: the arms mark coverage only when a report or an export asks for it (then
+  // every IF keeps its jumps); without, the tests run the code `plcfi run` runs.
+  opt->coverage = vm.count("coverage") > 0 || coverage_export_wanted(vm);
+  opt->loop_tails = !vm.count("native");
+  opt->if_selects = !vm.count("native");
   return true;
 }
 
