@@ -139,13 +139,6 @@ Val void_val(Compiler& cc) {
   return none;
 }
 
-Val slot_val(const Type* t, Slot s) {
-  Val out;
-  out.type = t;
-  out.slot = s;
-  return out;
-}
-
 using Emitter = std::optional<Val> (Compiler::*)(const StdFunc&, const CallExpr&);
 
 // The emitter of each family. A switch without a default: a family added without an

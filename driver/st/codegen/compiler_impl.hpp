@@ -95,6 +95,14 @@ struct Val {
   const Type* nominal = nullptr;
 };
 
+// The value of type t held in slot s.
+inline Val slot_val(const Type* t, Slot s) {
+  Val out;
+  out.type = t;
+  out.slot = s;
+  return out;
+}
+
 // An lvalue.
 struct Place {
   enum class K : uint8_t { Frame, Abs, AbsBit, Ind, FrameIdx, Bit } k = K::Frame;
@@ -361,6 +369,10 @@ class Compiler {
   // any index, e may fail a bounds check), else null.
   const Type* plain_read_type(const Expr& e, const std::vector<const IndexExpr*>* checked, int depth);
   bool test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero);
+  // The instruction before the comparison at cmp_at (integer storage type_idx), when it
+  // defines a temporary the comparison reads against a constant 0, in the same line and
+  // block: its position (test_bits, single_bit).
+  std::optional<uint32_t> zero_tested_temp(uint32_t cmp_at, uint32_t type_idx) const;
   // Rule 26: an IF on a test of bits whose arms assign one variable values that cannot
   // fail, compiled as a select (CompileOptions::if_selects; see stmt.cpp). False:
   // nothing emitted, the IF is compiled with jumps.

@@ -73,22 +73,27 @@ std::optional<uint64_t> Compiler::const_at(uint32_t word, uint32_t width) const 
 // on x and m, when the AND is the instruction right before the comparison, in the same
 // statement line and block, and defines a temporary only the comparison reads. `if_zero`:
 // the jump is to be taken when the AND gives zero. False: nothing changed.
-bool Compiler::test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero) {
-  auto& code = b_->code;
-  const uint32_t and_at = b_->prev_instr;
-  if (and_at == UINT32_MAX || and_at >= cmp_at || and_at < b_->last_label_pos || type_idx >= 8) return false;
-  constexpr uint32_t stride = static_cast<uint32_t>(Op::MOD_I16) - static_cast<uint32_t>(Op::MOD_I8);
-  if (code[and_at] != static_cast<uint32_t>(Op::AND_I8) + type_idx * stride || and_at + 4 != cmp_at) return false;
-  if (!b_->lines.empty() && b_->lines.back().first > and_at) return false;
+std::optional<uint32_t> Compiler::zero_tested_temp(uint32_t cmp_at, uint32_t type_idx) const {
+  const auto& code = b_->code;
+  const uint32_t op_at = b_->prev_instr;
+  if (op_at == UINT32_MAX || op_at >= cmp_at || op_at < b_->last_label_pos || type_idx >= 8) return std::nullopt;
+  if (!b_->lines.empty() && b_->lines.back().first > op_at) return std::nullopt;
   static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8};
   auto zero = [&](uint32_t word) { return const_at(word, kWidth[type_idx]) == uint64_t{0}; };
-  // The comparison reads the AND's temporary and a constant zero, in either order.
-  const uint32_t t = code[and_at + 1];
-  if (kind_at(and_at + 1) != SK::Temp) return false;
-  const bool t_first = code[cmp_at + 2] == t && kind_at(cmp_at + 2) == SK::Temp && zero(cmp_at + 3);
-  const bool t_second = code[cmp_at + 3] == t && kind_at(cmp_at + 3) == SK::Temp && zero(cmp_at + 2);
-  if (!t_first && !t_second) return false;
-  auto [x, y] = unemit(and_at);
+  // The comparison reads op_at's temporary and a constant zero, in either order.
+  const uint32_t t = code[op_at + 1];
+  if (kind_at(op_at + 1) != SK::Temp) return std::nullopt;
+  auto is_t = [&](uint32_t word) { return code[word] == t && kind_at(word) == SK::Temp; };
+  if (!(is_t(cmp_at + 2) && zero(cmp_at + 3)) && !(is_t(cmp_at + 3) && zero(cmp_at + 2))) return std::nullopt;
+  return op_at;
+}
+
+bool Compiler::test_bits(uint32_t cmp_at, uint32_t type_idx, Label target, bool if_zero) {
+  const std::optional<uint32_t> and_at = zero_tested_temp(cmp_at, type_idx);
+  constexpr uint32_t stride = static_cast<uint32_t>(Op::MOD_I16) - static_cast<uint32_t>(Op::MOD_I8);
+  if (!and_at || b_->code[*and_at] != static_cast<uint32_t>(Op::AND_I8) + type_idx * stride || *and_at + 4 != cmp_at)
+    return false;
+  auto [x, y] = unemit(*and_at);
   emit(int_op(if_zero ? Op::JTZ_I8 : Op::JTNZ_I8, static_cast<Storage>(type_idx)), {Arg::target(target.id), x, y});
   b_->last_def_pos = UINT32_MAX;
   return true;
@@ -173,6 +178,15 @@ bool is_and_or(const Expr& e) {
   if (e.kind != ExprKind::Binary) return false;
   const BinaryOp op = static_cast<const BinaryExpr&>(e).op;
   return op == BinaryOp::And || op == BinaryOp::Or;
+}
+
+// Whether b is no division or MOD, or one by a number written out that is not zero (a
+// variable divisor may be zero).
+bool divisor_cannot_fail(const BinaryExpr& b) {
+  if (b.op != BinaryOp::Div && b.op != BinaryOp::Mod) return true;
+  if (b.rhs->kind != ExprKind::Literal) return false;
+  const auto& d = static_cast<const LiteralExpr&>(*b.rhs);
+  return (d.lit == LiteralKind::Int && d.int_value != 0) || (d.lit == LiteralKind::Real && d.real_value != 0);
 }
 
 // Whether two expressions that plain_read_type accepts are written alike (names compared
@@ -294,13 +308,7 @@ const Type* Compiler::plain_read_type(const Expr& e, const std::vector<const Ind
     case ExprKind::Binary: {
       const auto& b = static_cast<const BinaryExpr&>(e);
       if (b.op == BinaryOp::Pow || b.op == BinaryOp::AndThen || b.op == BinaryOp::OrElse) return nullptr;
-      if (b.op == BinaryOp::Div || b.op == BinaryOp::Mod) {
-        // Only by a number written out that is not zero: a variable divisor may be zero.
-        if (b.rhs->kind != ExprKind::Literal) return nullptr;
-        const auto& d = static_cast<const LiteralExpr&>(*b.rhs);
-        if (!(d.lit == LiteralKind::Int && d.int_value != 0) && !(d.lit == LiteralKind::Real && d.real_value != 0))
-          return nullptr;
-      }
+      if (!divisor_cannot_fail(b)) return nullptr;
       const Type* l = plain_read_type(*b.lhs, checked, depth + 1);
       const Type* r = l ? plain_read_type(*b.rhs, checked, depth + 1) : nullptr;
       if (!l || !r) return nullptr;
@@ -797,12 +805,7 @@ bool Compiler::select_safe(const Expr& e, const std::vector<const IndexExpr*>* c
     case ExprKind::Binary: {
       const auto& b = static_cast<const BinaryExpr&>(e);
       if (b.op == BinaryOp::Pow || b.op == BinaryOp::AndThen || b.op == BinaryOp::OrElse) return false;
-      if (b.op == BinaryOp::Div || b.op == BinaryOp::Mod) {
-        if (b.rhs->kind != ExprKind::Literal) return false;  // a variable divisor may be zero
-        const auto& d = static_cast<const LiteralExpr&>(*b.rhs);
-        if (!(d.lit == LiteralKind::Int && d.int_value != 0) && !(d.lit == LiteralKind::Real && d.real_value != 0))
-          return false;
-      }
+      if (!divisor_cannot_fail(b)) return false;
       return select_safe(*b.lhs, checked, depth + 1) && select_safe(*b.rhs, checked, depth + 1);
     }
     case ExprKind::Call: {
@@ -847,31 +850,14 @@ bool int_literal(const Expr& e, uint64_t* value) {
 }
 }  // namespace
 
-// Rule 26 (chosen on the tuning half): an IF whose condition tests bits of data and whose
-// arms each assign the same variable, `IF (crc AND 16#8000) <> 0 THEN crc := SHL(crc, 1)
-// XOR 16#1021; ELSE crc := SHL(crc, 1); END_IF` or `IF flags[i] THEN w := w OR SHL(WORD#1,
-// k); END_IF`, evaluates both values and selects one (SEL1..SEL8): such bits are
-// data, a CRC's or a parity's or a flag array's, and a jump on them goes either way at
-// random (a mispredicted jump costs more than the few instructions of the other arm).
-// Comparisons of magnitudes (limits, state machine events, counters) and BOOL status
-// variables (an edge's Q, a limit switch) mostly go one way and keep their jump: selects
-// made the tuning kernels that have them slower. Applies when the arms only read
-// variables and cannot fail (select_safe), so evaluating the arm not taken cannot be
-// seen; the variable is a plain one of a type of 1, 2, 4 or 8 bytes without a subrange;
-// the condition is an element of a BOOL array or a bit of a word (w.3), NOT of one, or
-// (x AND K) or x MOD 2^k compared (= or <>) with 0; there is no ELSIF; and no coverage
-// is collected. The condition is evaluated once, as before.
 // A comparison of one bit with 0 that was just emitted as a value, "AND t, x, m; EQ/NE
 // c, t, 0" with a single-bit constant m (either operand order) or "MODK t, x, .., 2;
 // EQ/NE c, t, 0", in the same line and block, t read by the comparison only: replaced by
 // one GETBIT of x, the bit (set: the "<> 0"; *inverted for "= 0"). Nullopt: nothing changed.
 std::optional<Slot> Compiler::single_bit(bool* inverted) {
   auto& code = b_->code;
-  const uint32_t cmp_at = b_->last_instr, op_at = b_->prev_instr;
-  if (cmp_at >= code.size() || op_at == UINT32_MAX || op_at >= cmp_at || op_at < b_->last_label_pos ||
-      cmp_at + 4 != code.size())
-    return std::nullopt;
-  if (!b_->lines.empty() && b_->lines.back().first > op_at) return std::nullopt;
+  const uint32_t cmp_at = b_->last_instr;
+  if (cmp_at >= code.size() || cmp_at + 4 != code.size()) return std::nullopt;
   constexpr uint32_t num_stride = static_cast<uint32_t>(Op::ADD_I16) - static_cast<uint32_t>(Op::ADD_I8);
   constexpr uint32_t int_stride = static_cast<uint32_t>(Op::MOD_I16) - static_cast<uint32_t>(Op::MOD_I8);
   static constexpr uint32_t kWidth[] = {1, 2, 4, 8, 1, 2, 4, 8};
@@ -881,16 +867,11 @@ std::optional<Slot> Compiler::single_bit(bool* inverted) {
     if (code[cmp_at] == static_cast<uint32_t>(Op::EQ_I8) + k * num_stride) ti = k, eq = true;
     if (code[cmp_at] == static_cast<uint32_t>(Op::NE_I8) + k * num_stride) ti = k;
   }
-  if (ti == 8) return std::nullopt;
-  // The comparison reads the temporary op_at defined and a constant 0.
-  const uint32_t t = code[op_at + 1];
-  if (kind_at(op_at + 1) != SK::Temp) return std::nullopt;
-  auto zero = [&](uint32_t word) { return const_at(word, kWidth[ti]) == uint64_t{0}; };
-  auto is_t = [&](uint32_t word) { return code[word] == t && kind_at(word) == SK::Temp; };
-  if (!(is_t(cmp_at + 2) && zero(cmp_at + 3)) && !(is_t(cmp_at + 3) && zero(cmp_at + 2))) return std::nullopt;
+  const std::optional<uint32_t> at = ti < 8 ? zero_tested_temp(cmp_at, ti) : std::nullopt;
+  if (!at) return std::nullopt;
+  const uint32_t op_at = *at, op = code[op_at], t = code[op_at + 1];
   uint32_t bit = 0;
   bool x_second = false;  // AND's x is its second operand (the mask the first)
-  const uint32_t op = code[op_at];
   if (op == static_cast<uint32_t>(Op::AND_I8) + ti * int_stride && op_at + 4 == cmp_at) {
     auto single = [&](uint32_t word) -> std::optional<uint32_t> {
       std::optional<uint64_t> m = const_at(word, kWidth[ti]);
@@ -920,6 +901,20 @@ std::optional<Slot> Compiler::single_bit(bool* inverted) {
   return d;
 }
 
+// Rule 26 (chosen on the tuning half): an IF whose condition tests bits of data and whose
+// arms each assign the same variable, `IF (crc AND 16#8000) <> 0 THEN crc := SHL(crc, 1)
+// XOR 16#1021; ELSE crc := SHL(crc, 1); END_IF` or `IF flags[i] THEN w := w OR SHL(WORD#1,
+// k); END_IF`, evaluates both values and selects one (SEL1..SEL8): such bits are
+// data, a CRC's or a parity's or a flag array's, and a jump on them goes either way at
+// random (a mispredicted jump costs more than the few instructions of the other arm).
+// Comparisons of magnitudes (limits, state machine events, counters) and BOOL status
+// variables (an edge's Q, a limit switch) mostly go one way and keep their jump: selects
+// made the tuning kernels that have them slower. Applies when the arms only read
+// variables and cannot fail (select_safe), so evaluating the arm not taken cannot be
+// seen; the variable is a plain one of a type of 1, 2, 4 or 8 bytes without a subrange;
+// the condition is an element of a BOOL array or a bit of a word (w.3), NOT of one, or
+// (x AND K) or x MOD 2^k compared (= or <>) with 0; there is no ELSIF; and no coverage
+// is collected. The condition is evaluated once, as before.
 bool Compiler::select_if(const IfStmt& s) {
   if (!opt_.if_selects || opt_.coverage || s.arms.size() != 1 || !s.arms[0].label.empty()) return false;
   const auto& arm = s.arms[0];
@@ -1010,11 +1005,8 @@ bool Compiler::select_if(const IfStmt& s) {
   Slot d = temp_for(t);
   emit(sel_op(t->size), {d, test, when ? *a : *b, when ? *b : *a});
   def(d, 1);
-  Val chosen;
-  chosen.type = t;
-  chosen.slot = d;
   Place dst = place(*yes->lhs, true);
-  assign(dst, chosen, yes->loc);
+  assign(dst, slot_val(t, d), yes->loc);
   b_->temp_top = saved;
   b_->cvt_cache.clear();
   app_->if_selects = true;
