@@ -49,6 +49,10 @@ struct CompileOptions {
   // only without coverage (the arms mark nothing then). Off, jumps (mutation analysis
   // negates the IF's one jump; the native tier leaves the choice to the C compiler).
   bool if_selects = true;
+  // An ELSIF condition that reads the array element the condition before it compared
+  // reads the value that comparison loaded, without loading it again (see if_stmt); off,
+  // it loads it (mutation analysis patches one condition at a time).
+  bool elsif_reuse = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

@@ -182,6 +182,9 @@ struct Body {
   uint32_t last_instr = UINT32_MAX;
   uint32_t prev_instr = UINT32_MAX;  // the instruction before last_instr, while both stand
   uint32_t prev2_instr = UINT32_MAX;  // the instruction before prev_instr, while all three stand
+  // The last two element reads compiled as a load into a temporary: the expression and
+  // the load's position (rule 27, compared_element).
+  std::pair<const Expr*, uint32_t> elem_loads[2] = {{nullptr, UINT32_MAX}, {nullptr, UINT32_MAX}};
   // Conversions already done in the statement being compiled (an index used twice).
   std::map<std::tuple<uint32_t, SK, Storage, Storage>, Slot> cvt_cache;
   std::unordered_map<std::string, Symbol*> locals;  // canon name -> symbol (frame or This)
@@ -377,6 +380,15 @@ class Compiler {
   // fail, compiled as a select (CompileOptions::if_selects; see stmt.cpp). False:
   // nothing emitted, the IF is compiled with jumps.
   bool select_if(const IfStmt& s);
+  // Rule 27: the elements a condition just compiled as `a <cmp> b` loaded into temporaries
+  // its one jump to `next` reads, or that `carried` held for it (see if_stmt).
+  struct HeldElement {
+    const Expr* e = nullptr;
+    Slot slot;
+    const Type* type = nullptr;
+  };
+  using Held = std::vector<HeldElement>;
+  Held compared_elements(const Expr& cond, Label next, const Held& carried);
   // The comparison of one bit with 0 just emitted as a value, as one GETBIT (see stmt.cpp).
   std::optional<Slot> single_bit(bool* inverted);
   // Whether evaluating e only reads variables, calls standard functions that compute a

@@ -582,6 +582,13 @@ Val Compiler::expr(const Expr& e, const Type* expected) {
     }
     return bad();
   }();
+  // Rule 27: which element the instruction just emitted loaded into which temporary.
+  if ((e.kind == ExprKind::Index || e.kind == ExprKind::Member) && r.ok && !r.is_const && r.slot.kind == SK::Temp && b_ &&
+      b_->last_instr + 1 < b_->code.size() && b_->last_def_pos == b_->last_instr &&
+      b_->code[b_->last_instr + 1] == r.slot.off && kind_at(b_->last_instr + 1) == SK::Temp) {
+    b_->elem_loads[1] = b_->elem_loads[0];
+    b_->elem_loads[0] = {&e, b_->last_instr};
+  }
   return r;
 }
 

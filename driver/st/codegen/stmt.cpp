@@ -1013,30 +1013,145 @@ bool Compiler::select_if(const IfStmt& s) {
   return true;
 }
 
+namespace {
+bool is_comparison(BinaryOp op) {
+  return op == BinaryOp::Eq || op == BinaryOp::Ne || op == BinaryOp::Lt || op == BinaryOp::Gt || op == BinaryOp::Le ||
+         op == BinaryOp::Ge;
+}
+
+// The nodes of e (an expression plain_read_type accepts) written as `x` is.
+void find_same(const Expr& e, const Expr& x, std::vector<const Expr*>* out, int depth) {
+  if (depth > 64) return;
+  if (same_expr(e, x, 0)) {
+    out->push_back(&e);
+    return;
+  }
+  switch (e.kind) {
+    case ExprKind::Member: find_same(*static_cast<const MemberExpr&>(e).base, x, out, depth + 1); break;
+    case ExprKind::BitAccess: find_same(*static_cast<const BitAccessExpr&>(e).base, x, out, depth + 1); break;
+    case ExprKind::Index:
+      for (const auto& i : static_cast<const IndexExpr&>(e).indices) find_same(*i, x, out, depth + 1);
+      break;
+    case ExprKind::Unary: find_same(*static_cast<const UnaryExpr&>(e).operand, x, out, depth + 1); break;
+    case ExprKind::Binary:
+      find_same(*static_cast<const BinaryExpr&>(e).lhs, x, out, depth + 1);
+      find_same(*static_cast<const BinaryExpr&>(e).rhs, x, out, depth + 1);
+      break;
+    default: break;
+  }
+}
+}  // namespace
+
+// Rule 27, for `IF tags[half].tag = want THEN ... ELSIF tags[half].tag < want THEN` and
+// `IF x[i] > top THEN top := x[i];`: a condition that compares two operands that only
+// read (plain_read_type), each a variable, a literal or an array element, ends with one
+// jump to `next` reading the temporaries the elements were loaded into, in the block the
+// loads are in (a load converted before the comparison is not the element as its type has
+// it: not held). Where the jump goes and where it falls through, nothing has run since
+// the loads: the temporaries hold the elements, with array and index unchanged. An ELSIF
+// that compared an element `carried` held for it (no load of its own) hands it on.
+Compiler::Held Compiler::compared_elements(const Expr& cond, Label next, const Held& carried) {
+  if (!opt_.elsif_reuse || cond.kind != ExprKind::Binary) return {};
+  const auto& b = static_cast<const BinaryExpr&>(cond);
+  if (!is_comparison(b.op) || !plain_read_type(cond, nullptr, 0)) return {};
+  const auto& code = b_->code;
+  const uint32_t j = b_->last_instr;
+  if (j >= code.size() || j < b_->last_label_pos || j + op_length(&code[j]) != code.size()) return {};
+  if (!is_conditional_jump(static_cast<Op>(code[j])) || b_->label_refs[next.id] != 1) return {};
+  if (std::none_of(b_->target_fix.begin(), b_->target_fix.end(),
+                   [&](const auto& f) { return f.first == j + 1 && f.second == next.id; }))
+    return {};
+  auto jump_reads = [&](Slot t) {
+    for (uint32_t w = j + 2; w < j + op_length(&code[j]); ++w)
+      if (code[w] == t.off && kind_at(w) == SK::Temp) return true;
+    return false;
+  };
+  Held out;
+  for (const Expr* side : {b.lhs.get(), b.rhs.get()}) {
+    if (side->kind != ExprKind::Index && side->kind != ExprKind::Member) continue;
+    const Type* t = plain_read_type(*side, nullptr, 0);
+    std::vector<const IndexExpr*> indexes;
+    collect_indexes(*side, &indexes, 0);
+    if (!t || !t->is_elementary() || t->is_string() || indexes.empty()) continue;
+    const auto from = std::find_if(carried.begin(), carried.end(), [&](const HeldElement& h) { return same_expr(*side, *h.e, 0); });
+    if (from != carried.end()) {
+      if (jump_reads(from->slot)) out.push_back({side, from->slot, t});
+      continue;
+    }
+    for (const auto& [e, at] : b_->elem_loads) {
+      if (e != side || at < b_->last_label_pos || at >= j || kind_at(at + 1) != SK::Temp) continue;
+      const std::string_view name = op_info(static_cast<Op>(code[at])).name;
+      if (!(name.starts_with("LDX") || name.starts_with("LDI")) || name == "LDXB") continue;
+      const Slot held{code[at + 1], SK::Temp};
+      if (jump_reads(held)) out.push_back({side, held, t});
+    }
+  }
+  return out;
+}
+
 void Compiler::if_stmt(const IfStmt& s) {
   if (select_if(s)) return;
   Label end = new_label();
   uint32_t decision = kNoBranch;
+  // Rule 27: what the condition before held (for an ELSIF's condition or the ELSE's first
+  // statement) and what an arm's own condition holds (for the arm's first statement).
+  Held held;
+  std::vector<const Expr*> reuse;
+  // Presets the reads of h's element in e (only reads, no call: nothing between writes
+  // the array, the index or the temporary), the temporaries of e's code after h's.
+  auto hold = [&](const Expr* e, const Held& hs) {
+    reuse.clear();
+    if (hs.empty() || !e || !plain_read_type(*e, nullptr, 0)) return;
+    for (const HeldElement& h : hs) {
+      const size_t before = reuse.size();
+      find_same(*e, *h.e, &reuse, 0);
+      for (size_t k = before; k < reuse.size(); ++k) preset_[reuse[k]] = slot_val(h.type, h.slot);
+      if (reuse.size() > before) b_->temp_top = std::max(b_->temp_top, h.slot.off + h.type->size);
+    }
+    if (!reuse.empty()) app_->elsif_reuse = true;
+  };
+  auto release = [&] {
+    for (const Expr* x : reuse) preset_.erase(x);
+  };
+  // The value an arm's first statement assigns, when it is a plain assignment (its
+  // target's indexes only read): a read of the held element there comes before any store.
+  auto first_value = [&](const StmtList& body) -> const Expr* {
+    if (body.empty() || body[0]->kind != StmtKind::Assign) return nullptr;
+    const auto& a = static_cast<const AssignStmt&>(*body[0]);
+    if (a.is_ref_assign || a.set_reset || a.chained || a.declares_temp || !plain_read_type(*a.lhs, nullptr, 0)) return nullptr;
+    return a.rhs.get();
+  };
   for (size_t i = 0; i < s.arms.size(); ++i) {
     const auto& arm = s.arms[i];
     uint32_t saved = b_->temp_top;
     mark(arm.loc);
     Label next = new_label();
+    hold(arm.cond.get(), held);
+    const bool carried = !reuse.empty();
     Val c = cond_branch(*arm.cond, next, false);
+    release();
     if (opt_.warnings && c.ok && c.is_const && !(b_->pou && b_->pou->is_stdlib))
       diags_.warning("ST404", arm.cond->loc, std::string("condition is always ") + (c.c.i ? "TRUE" : "FALSE"));
+    held = c.ok && !c.is_const ? compared_elements(*arm.cond, next, carried ? held : Held{}) : Held{};
     b_->temp_top = saved;
     {
       const char* kind = !arm.label.empty() ? arm.label.c_str() : i == 0 ? "IF" : "ELSIF";
       ArmScope in(b_, branch(arm.loc, kind, s.loc, &decision, arm.body));
+      hold(first_value(arm.body), held);
       stmts(arm.body);
+      release();
+      b_->temp_top = saved;
     }
     if (i + 1 < s.arms.size() || s.else_body) arm_end(end);
     bind(next);
   }
   if (s.else_body) {
     ArmScope in(b_, branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE", s.loc, &decision, *s.else_body));
+    const uint32_t saved = b_->temp_top;
+    hold(first_value(*s.else_body), held);
     stmts(*s.else_body);
+    release();
+    b_->temp_top = saved;
   }
   bind_forward(end);
 }

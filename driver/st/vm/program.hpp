@@ -220,6 +220,9 @@ class Application {
   // Some IF is a select instruction, not a jump (CompileOptions::if_selects): mutation
   // analysis needs the jump.
   bool if_selects = false;
+  // Some ELSIF condition reads an element the condition before it loaded
+  // (CompileOptions::elsif_reuse): mutation analysis negates conditions one at a time.
+  bool elsif_reuse = false;
   // FB_init/FB_exit (CODESYS): a routine over every program instance and global instance,
   // run by Machine::cold_restart/warm_restart on the frame at lifecycle_addr.
   // The byte at init_flag_addr is what FB_init gets as bInitRetains.
