@@ -190,6 +190,8 @@ bool Compiler::retarget(Slot from, Slot to) {
   auto it = std::find_if(b_->slot_fix.begin(), b_->slot_fix.end(), [&](const auto& e) { return e.first == word; });
   if (it != b_->slot_fix.end()) b_->slot_fix.erase(it);
   b_->code[word] = to.off;
+  for (auto& w : b_->flag_watches)
+    if (to.kind == SK::Var && to.off == w.off) w.dirty = w.ever = true;
   if (to.kind != SK::Var) b_->slot_fix.emplace_back(word, to.kind);
   b_->last_def_pos = UINT32_MAX;
   return true;
@@ -201,6 +203,7 @@ void Compiler::emit_list(Op op, const std::vector<Arg>& args) {
   // after a store into a variable (the cache holds conversions of variables).
   if (op == Op::CALL || op == Op::CALLA || op == Op::CALLP || op == Op::CALLS || op == Op::CALLV || op == Op::NATIVE)
     b_->cvt_cache.clear();
+  if (!b_->flag_watches.empty()) watch_writes(op, args);
   b_->prev2_instr = b_->prev_instr < code.size() && b_->last_instr < code.size() ? b_->prev_instr : UINT32_MAX;
   b_->prev_instr = b_->last_instr < code.size() ? b_->last_instr : UINT32_MAX;
   b_->last_instr = static_cast<uint32_t>(code.size());

@@ -53,6 +53,10 @@ struct CompileOptions {
   // reads the value that comparison loaded, without loading it again (see if_stmt); off,
   // it loads it (mutation analysis patches one condition at a time).
   bool elsif_reuse = true;
+  // With loop_tails (off for mutation analysis): an arm that ends a WHILE body whose
+  // condition is a BOOL variable, on a path that cannot have written it, jumps back
+  // without testing it (see while_stmt); off, it tests it (tests compare the two).
+  bool flag_loops = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

@@ -210,6 +210,16 @@ struct Body {
   std::vector<Edge> edges;
   std::optional<Slot> started;  // TRUE once a state has been committed
   std::optional<Slot> state_seen;  // the last __state evaluated
+  // Rule 28: the BOOL variables (frame offsets) that enclosing WHILE loops test, and
+  // whether the path being compiled may have written one since its loop's test passed
+  // (an instruction storing it, or one that may store anywhere: a call, a store through
+  // a pointer, ...; see watch_writes).
+  struct FlagWatch {
+    uint32_t off;
+    bool dirty;
+    bool ever = false;  // written anywhere since the innermost loop being compiled began
+  };
+  std::vector<FlagWatch> flag_watches;
 };
 
 // What the compiler knows of a POU beyond the compiled program: its declaration in the
@@ -509,6 +519,16 @@ class Compiler {
   const std::function<void()>* loop_tail_ = nullptr;
   void arm_end(Label end);
   void bottom_test(const Expr& c, Label body, bool again);
+  // Rule 28 (see while_stmt): the frame offset of a WHILE condition that is a BOOL
+  // variable of the frame; what an instruction about to be emitted may write of the
+  // watched ones; their states, to follow the arms of an IF or CASE; the jump back to a
+  // loop's body from an arm that left its flag TRUE.
+  std::optional<uint32_t> loop_flag(const Expr& cond);
+  void watch_writes(Op op, const std::vector<Arg>& args);
+  std::vector<bool> watch_state() const;
+  void set_watch_state(const std::vector<bool>& s);
+  static void merge_watch_state(std::vector<bool>* into, const std::vector<bool>& s);
+  void jump_back(Label body);
   // What row_candidates looks for: accesses by `counter` and one of `outer` (the counters
   // of the proven loops around it), none by `inner` (counters of loops nested in it, whose
   // accesses those loops keep rows for).

@@ -536,6 +536,7 @@ void Compiler::label_stmt(const LabelStmt& s) {
   }
   // A label declared twice binds where it was first declared (the second is reported).
   if (it->second.second.line == s.name.loc.line && it->second.second.col == s.name.loc.col) bind(it->second.first);
+  for (auto& w : b_->flag_watches) w.dirty = w.ever = true;  // a JMP from anywhere may lead here (rule 28)
 }
 
 void Compiler::jump_stmt(const JumpStmt& s) {
@@ -598,9 +599,24 @@ void Compiler::stmt(const Stmt& s) {
       break;
     case StmtKind::If: if_stmt(static_cast<const IfStmt&>(s)); break;
     case StmtKind::Case: case_stmt(static_cast<const CaseStmt&>(s)); break;
-    case StmtKind::For: for_stmt(static_cast<const ForStmt&>(s)); break;
-    case StmtKind::While: while_stmt(static_cast<const WhileStmt&>(s)); break;
-    case StmtKind::Repeat: repeat_stmt(static_cast<const RepeatStmt&>(s)); break;
+    case StmtKind::For: case StmtKind::While: case StmtKind::Repeat: {
+      // Rule 28: the paths through a loop come back to its start; what its body may
+      // write anywhere, it may have written where the loop is left.
+      std::vector<bool> ever;
+      for (auto& w : b_->flag_watches) {
+        ever.push_back(w.ever);
+        w.ever = false;
+      }
+      if (s.kind == StmtKind::For) for_stmt(static_cast<const ForStmt&>(s));
+      else if (s.kind == StmtKind::While) while_stmt(static_cast<const WhileStmt&>(s));
+      else repeat_stmt(static_cast<const RepeatStmt&>(s));
+      for (size_t k = 0; k < ever.size() && k < b_->flag_watches.size(); ++k) {
+        auto& w = b_->flag_watches[k];
+        w.dirty = w.dirty || w.ever;
+        w.ever = w.ever || ever[k];
+      }
+      break;
+    }
     case StmtKind::Exit:
     case StmtKind::Continue:
       if (b_->loops.empty()) {
@@ -1121,11 +1137,17 @@ void Compiler::if_stmt(const IfStmt& s) {
     if (a.is_ref_assign || a.set_reset || a.chained || a.declares_temp || !plain_read_type(*a.lhs, nullptr, 0)) return nullptr;
     return a.rhs.get();
   };
+  // Rule 28: each arm starts from what the conditions before it left; the IF's end is
+  // reached from the arms that end with a jump to it (not those that end a loop body
+  // with a copy of its bottom) and from the last condition without ELSE.
+  const bool tails = loop_tail_ != nullptr;
+  std::vector<bool> conds = watch_state(), after = conds;
   for (size_t i = 0; i < s.arms.size(); ++i) {
     const auto& arm = s.arms[i];
     uint32_t saved = b_->temp_top;
     mark(arm.loc);
     Label next = new_label();
+    set_watch_state(conds);
     hold(arm.cond.get(), held);
     const bool carried = !reuse.empty();
     Val c = cond_branch(*arm.cond, next, false);
@@ -1133,6 +1155,7 @@ void Compiler::if_stmt(const IfStmt& s) {
     if (opt_.warnings && c.ok && c.is_const && !(b_->pou && b_->pou->is_stdlib))
       diags_.warning("ST404", arm.cond->loc, std::string("condition is always ") + (c.c.i ? "TRUE" : "FALSE"));
     held = c.ok && !c.is_const ? compared_elements(*arm.cond, next, carried ? held : Held{}) : Held{};
+    conds = watch_state();
     b_->temp_top = saved;
     {
       const char* kind = !arm.label.empty() ? arm.label.c_str() : i == 0 ? "IF" : "ELSIF";
@@ -1143,8 +1166,10 @@ void Compiler::if_stmt(const IfStmt& s) {
       b_->temp_top = saved;
     }
     if (i + 1 < s.arms.size() || s.else_body) arm_end(end);
+    if (!tails || (i + 1 == s.arms.size() && !s.else_body)) merge_watch_state(&after, watch_state());
     bind(next);
   }
+  set_watch_state(conds);
   if (s.else_body) {
     ArmScope in(b_, branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE", s.loc, &decision, *s.else_body));
     const uint32_t saved = b_->temp_top;
@@ -1153,6 +1178,8 @@ void Compiler::if_stmt(const IfStmt& s) {
     release();
     b_->temp_top = saved;
   }
+  merge_watch_state(&after, watch_state());
+  set_watch_state(after);
   bind_forward(end);
 }
 
@@ -1249,19 +1276,27 @@ void Compiler::case_stmt(const CaseStmt& s) {
     emit(Op::JMP, {Arg::target(else_label.id)});
   }
   uint32_t decision = kNoBranch;
+  const std::vector<bool> start = watch_state();  // rule 28, as in if_stmt
+  const bool tails = loop_tail_ != nullptr;
+  std::vector<bool> after = start;
   for (size_t a = 0; a < s.arms.size(); ++a) {
     bind(arm_labels[a]);
+    set_watch_state(start);
     {
       ArmScope in(b_, branch(s.arms[a].loc, "CASE", s.loc, &decision, s.arms[a].body));
       stmts(s.arms[a].body);
     }
     arm_end(end);
+    if (!tails) merge_watch_state(&after, watch_state());
   }
   bind(else_label);
+  set_watch_state(start);
   if (s.else_body) {
     ArmScope in(b_, branch(s.else_loc.valid() ? s.else_loc : s.loc, "ELSE", s.loc, &decision, *s.else_body));
     stmts(*s.else_body);
   }
+  merge_watch_state(&after, watch_state());
+  set_watch_state(after);
   bind(end);
 }
 
@@ -1721,27 +1756,111 @@ void Compiler::bottom_test(const Expr& c, Label body, bool again) {
 // a test and a jump (the VM and the native tier count a conditional jump back against the
 // watchdog, as JMPB). WHILE tests once more on entry, with its own copy of the condition,
 // so its coverage id is set once per entry into a loop that runs, not per iteration.
+//
+// Rule 28: `WHILE moving DO IF j = 0 THEN moving := FALSE; ELSIF items[j - 1].key >
+// tmp.key THEN (shift) ELSE moving := FALSE; END_IF; END_WHILE` (IEC's AND evaluates both
+// operands, so a flag is how a search loop stops). Where the body starts, the flag is
+// TRUE; an arm that ends the body with a copy of the test (loop tails) on a path that did
+// not write it (flag_watches: no store of it, no call, no store through a pointer) would
+// test TRUE again: it jumps back without the test, counted against the watchdog as the
+// test's jump is. When the body starts with a conditional jump on variables (`IF j = 0`),
+// the arm ends with a copy of that jump and a jump back past it, which leaves one jump per
+// pass where the test and the first jump were two.
+std::optional<uint32_t> Compiler::loop_flag(const Expr& cond) {
+  if (cond.kind != ExprKind::Name) return std::nullopt;
+  const Symbol* v = lookup(canon(static_cast<const NameExpr&>(cond).name.text));
+  if (!v || v->kind != SymKind::Var || !v->type || v->type->kind != TypeKind::Bool || v->where != Where::Frame)
+    return std::nullopt;
+  const Place p = place(cond, false);
+  if (!p.ok || p.k != Place::K::Frame || p.sk != SK::Var) return std::nullopt;
+  return p.off;
+}
+
+void Compiler::watch_writes(Op op, const std::vector<Arg>& args) {
+  // Instructions that may store other than into their first operand.
+  static constexpr std::string_view kAnywhere[] = {"CALL",  "NATIVE",  "FBENTER", "STI",     "STG",     "STBIT",
+                                                   "INITBLK", "MOVN", "SCPY",    "WSCPY",   "ADVTIME", "ASSERT",
+                                                   "SETMOCK", "FNMOCK", "ENTER", "FRAME",   "ROWS",    "TRAP"};
+  const std::string_view name = op_info(op).name;
+  const bool anywhere = std::any_of(std::begin(kAnywhere), std::end(kAnywhere), [&](std::string_view k) { return name.starts_with(k); });
+  for (auto& w : b_->flag_watches)
+    if (anywhere || (!args.empty() && args[0].k != Arg::K::Target && args[0].sk == SK::Var && args[0].v == w.off))
+      w.dirty = w.ever = true;
+}
+
+std::vector<bool> Compiler::watch_state() const {
+  std::vector<bool> s;
+  for (const auto& w : b_->flag_watches) s.push_back(w.dirty);
+  return s;
+}
+
+void Compiler::set_watch_state(const std::vector<bool>& s) {
+  for (size_t k = 0; k < s.size() && k < b_->flag_watches.size(); ++k) b_->flag_watches[k].dirty = s[k];
+}
+
+void Compiler::merge_watch_state(std::vector<bool>* into, const std::vector<bool>& s) {
+  for (size_t k = 0; k < s.size() && k < into->size(); ++k) (*into)[k] = (*into)[k] || s[k];
+}
+
+void Compiler::jump_back(Label body) {
+  const auto& code = b_->code;
+  const uint32_t at = b_->label_pos[body.id];
+  if (at < code.size() && is_conditional_jump(static_cast<Op>(code[at]))) {
+    const uint32_t len = op_length(&code[at]);
+    const auto target = std::find_if(b_->target_fix.begin(), b_->target_fix.end(), [&](const auto& f) { return f.first == at + 1; });
+    bool plain = at + len <= code.size() && target != b_->target_fix.end();
+    for (uint32_t w = at + 2; plain && w < at + len; ++w) plain = kind_at(w) == SK::Var || kind_at(w) == SK::Const;
+    if (plain) {
+      std::vector<Arg> args{Arg::target(target->second)};
+      for (uint32_t w = at + 2; w < at + len; ++w) args.push_back(Arg(Slot{code[w], kind_at(w)}));
+      emit_list(static_cast<Op>(code[at]), args);
+      const Label rest = new_label();
+      b_->label_pos[rest.id] = at + len;
+      emit(Op::JMPB, {Arg::target(rest.id)});
+      return;
+    }
+  }
+  emit(Op::JMPB, {Arg::target(body.id)});
+}
+
 void Compiler::while_stmt(const WhileStmt& s) {
   Label body = new_label(), test = new_label(), exit = new_label();
   uint32_t saved = b_->temp_top;
   if (!cond_branch(*s.cond, exit, false).ok) return;
   b_->temp_top = saved;
   uint32_t decision = kNoBranch;
+  const std::optional<uint32_t> flag = opt_.loop_tails && opt_.flag_loops ? loop_flag(*s.cond) : std::nullopt;
+  bool clean = false;
   {
     ArmScope in(b_, branch(s.loc, "WHILE", s.loc, &decision, s.body));
     bind(body);
     b_->loops.push_back({exit, test});
+    const size_t watch = b_->flag_watches.size();
+    if (flag) b_->flag_watches.push_back({*flag, false});
     const std::function<void()> tail = [&] {
+      if (flag && !b_->flag_watches.at(watch).dirty) {
+        jump_back(body);
+        return;
+      }
       bottom_test(*s.cond, body, true);
       emit(Op::JMP, {Arg::target(exit.id)});
     };
     loop_tail_ = opt_.loop_tails ? &tail : nullptr;
     stmts(s.body);
     loop_tail_ = nullptr;
+    // The body's end, reached by its last statement (not by CONTINUE, a jump to `test`).
+    if (flag) {
+      clean = !b_->flag_watches.back().dirty && b_->label_refs[test.id] == 0;
+      b_->flag_watches.pop_back();
+    }
     b_->loops.pop_back();
   }
-  bind_forward(test);
-  bottom_test(*s.cond, body, true);
+  if (clean) {
+    jump_back(body);
+  } else {
+    bind_forward(test);
+    bottom_test(*s.cond, body, true);
+  }
   bind(exit);
 }
 

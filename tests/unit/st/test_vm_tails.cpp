@@ -22,6 +22,7 @@ struct Prog : vmtest::VmRun {
   static CompileOptions options(bool tails) {
     CompileOptions o;
     o.loop_tails = tails;
+    o.flag_loops = false;  // the copies of the WHILE tests are the subject here (rule 28: test_vm_flag_loops.cpp)
     return o;
   }
 };
