@@ -95,6 +95,12 @@ struct Val {
   const Type* nominal = nullptr;
 };
 
+// One of the six comparisons (=, <>, <, >, <=, >=).
+inline bool is_cmp(BinaryOp op) {
+  return op == BinaryOp::Lt || op == BinaryOp::Gt || op == BinaryOp::Le || op == BinaryOp::Ge ||
+         op == BinaryOp::Eq || op == BinaryOp::Ne;
+}
+
 // The value of type t held in slot s.
 inline Val slot_val(const Type* t, Slot s) {
   Val out;
@@ -183,7 +189,7 @@ struct Body {
   uint32_t prev_instr = UINT32_MAX;  // the instruction before last_instr, while both stand
   uint32_t prev2_instr = UINT32_MAX;  // the instruction before prev_instr, while all three stand
   // The last two element reads compiled as a load into a temporary: the expression and
-  // the load's position (rule 27, compared_element).
+  // the load's position (rule 27, compared_elements).
   std::pair<const Expr*, uint32_t> elem_loads[2] = {{nullptr, UINT32_MAX}, {nullptr, UINT32_MAX}};
   // Conversions already done in the statement being compiled (an index used twice).
   std::map<std::tuple<uint32_t, SK, Storage, Storage>, Slot> cvt_cache;

@@ -11,10 +11,6 @@
 namespace plcfi::st::detail {
 
 namespace {
-bool is_cmp(BinaryOp op) {
-  return op == BinaryOp::Lt || op == BinaryOp::Gt || op == BinaryOp::Le || op == BinaryOp::Ge ||
-         op == BinaryOp::Eq || op == BinaryOp::Ne;
-}
 bool is_logic(BinaryOp op) { return op == BinaryOp::And || op == BinaryOp::Or || op == BinaryOp::Xor; }
 // The six comparisons on two folded operands of one kind; nullopt for other operators.
 template <class T>

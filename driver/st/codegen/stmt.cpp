@@ -1030,11 +1030,6 @@ bool Compiler::select_if(const IfStmt& s) {
 }
 
 namespace {
-bool is_comparison(BinaryOp op) {
-  return op == BinaryOp::Eq || op == BinaryOp::Ne || op == BinaryOp::Lt || op == BinaryOp::Gt || op == BinaryOp::Le ||
-         op == BinaryOp::Ge;
-}
-
 // The nodes of e (an expression plain_read_type accepts) written as `x` is.
 void find_same(const Expr& e, const Expr& x, std::vector<const Expr*>* out, int depth) {
   if (depth > 64) return;
@@ -1069,7 +1064,7 @@ void find_same(const Expr& e, const Expr& x, std::vector<const Expr*>* out, int 
 Compiler::Held Compiler::compared_elements(const Expr& cond, Label next, const Held& carried) {
   if (!opt_.elsif_reuse || cond.kind != ExprKind::Binary) return {};
   const auto& b = static_cast<const BinaryExpr&>(cond);
-  if (!is_comparison(b.op) || !plain_read_type(cond, nullptr, 0)) return {};
+  if (!is_cmp(b.op) || !plain_read_type(cond, nullptr, 0)) return {};
   const auto& code = b_->code;
   const uint32_t j = b_->last_instr;
   if (j >= code.size() || j < b_->last_label_pos || j + op_length(&code[j]) != code.size()) return {};
@@ -1777,12 +1772,19 @@ std::optional<uint32_t> Compiler::loop_flag(const Expr& cond) {
 }
 
 void Compiler::watch_writes(Op op, const std::vector<Arg>& args) {
-  // Instructions that may store other than into their first operand.
-  static constexpr std::string_view kAnywhere[] = {"CALL",  "NATIVE",  "FBENTER", "STI",     "STG",     "STBIT",
-                                                   "INITBLK", "MOVN", "SCPY",    "WSCPY",   "ADVTIME", "ASSERT",
-                                                   "SETMOCK", "FNMOCK", "ENTER", "FRAME",   "ROWS",    "TRAP"};
-  const std::string_view name = op_info(op).name;
-  const bool anywhere = std::any_of(std::begin(kAnywhere), std::end(kAnywhere), [&](std::string_view k) { return name.starts_with(k); });
+  // Instructions that may store other than into their first operand, by name, once.
+  static const std::vector<bool> kAnywhere = [] {
+    static constexpr std::string_view kFamilies[] = {"CALL",  "NATIVE", "FBENTER", "STI",     "STG",    "STBIT",
+                                                     "INITBLK", "MOVN", "SCPY",    "WSCPY",   "ADVTIME", "ASSERT",
+                                                     "SETMOCK", "FNMOCK", "ENTER", "FRAME",   "ROWS",   "TRAP"};
+    std::vector<bool> t(static_cast<size_t>(Op::Count_));
+    for (size_t i = 0; i < t.size(); ++i) {
+      const std::string_view name = op_info(static_cast<Op>(i)).name;
+      t[i] = std::any_of(std::begin(kFamilies), std::end(kFamilies), [&](std::string_view f) { return name.starts_with(f); });
+    }
+    return t;
+  }();
+  const bool anywhere = kAnywhere[static_cast<size_t>(op)];
   for (auto& w : b_->flag_watches)
     if (anywhere || (!args.empty() && args[0].k != Arg::K::Target && args[0].sk == SK::Var && args[0].v == w.off))
       w.dirty = w.ever = true;

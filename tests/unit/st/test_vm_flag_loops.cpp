@@ -203,5 +203,32 @@ END_PROGRAM
   }
 }
 
+// Flag loops nested `depth` deep, each ended by an IF in its own body: the innermost
+// counts k, loop i stops once k > i.
+std::string nested_flags(int depth) {
+  std::string src = "PROGRAM P\nVAR\n";
+  for (int i = 0; i < depth; ++i) src += "  f" + std::to_string(i) + " : BOOL := TRUE;\n";
+  src += "  k : DINT := 0;\nEND_VAR\n";
+  for (int i = 0; i < depth; ++i) src += "WHILE f" + std::to_string(i) + " DO\n";
+  src += "k := k + 1;\n";
+  for (int i = depth - 1; i >= 0; --i)
+    src += "IF k > " + std::to_string(i) + " THEN f" + std::to_string(i) + " := FALSE; END_IF;\nEND_WHILE;\n";
+  return src + "END_PROGRAM\n";
+}
+
+TEST(VmFlagLoops, DeepNestsRunOrEndInTheNestingError) {
+  const std::string deep = nested_flags(120);
+  for (bool on : {true, false}) {
+    VmRun p(deep, flags(on), "deep.st");
+    ASSERT_TRUE(p.ok());
+    ASSERT_TRUE(p.scan()) << p.m->trap().message;
+    EXPECT_EQ(p.get("P.k"), 120) << (on ? "with the rule" : "without");
+  }
+  same_in_both_tiers("deep.st", deep, 2, 0, nullptr, flags(true));
+  auto b = build_sources({{"deeper.st", nested_flags(200)}}, flags(true));
+  EXPECT_FALSE(b->ok());
+  EXPECT_NE(b->diags.render_all().find("ST117"), std::string::npos) << b->diags.render_all();
+}
+
 }  // namespace
 }  // namespace plcfi::st
