@@ -139,6 +139,7 @@ bool prepare_campaign(Campaign spec, CampaignBuild* out, std::string* err) {
   opt.loop_tails = !c.for_mutation;
   opt.if_selects = !c.for_mutation;
   opt.elsif_reuse = !c.for_mutation;
+  opt.cold_arms = !c.for_mutation;
   st::parse_dialect(c.dialect, &opt.dialect);  // checked when the file was read
 
   // 1. The program alone: bindings, alarms and fault targets are checked against it.

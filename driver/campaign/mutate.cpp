@@ -338,10 +338,11 @@ std::string run_fingerprint(const CampaignBuild& cb, const std::vector<Mutant>& 
 bool run_mutation(CampaignBuild& cb, const MutateOptions& opt, MutationRun* out, std::string* err) {
   auto wall0 = std::chrono::steady_clock::now();
   if (cb.build->app->condition_chains || cb.build->app->copied_statements || cb.build->app->if_selects ||
-      cb.build->app->elsif_reuse) {
+      cb.build->app->elsif_reuse || cb.build->app->cold_arms) {
     // The operators patch one jump per IF and one store per assignment (mutate_gen.cpp).
     *err = "plcfi mutate: internal: the program was compiled with conditions as chains of jumps, statements copied "
-           "into arms, IFs as selects or ELSIFs reading their predecessor's element (Campaign::for_mutation)";
+           "into arms, IFs as selects, ELSIFs reading their predecessor's element or arms that leave a loop placed last "
+           "(Campaign::for_mutation)";
     return false;
   }
   out->mutants = generate_mutants(cb);

@@ -57,6 +57,11 @@ struct CompileOptions {
   // condition is a BOOL variable, on a path that cannot have written it, jumps back
   // without testing it (see while_stmt); off, it tests it (tests compare the two).
   bool flag_loops = true;
+  // With loop_tails, and without coverage: in the IF that ends a loop body, an arm that
+  // leaves the loop (EXIT, RETURN, or a literal assigned to a variable the WHILE or UNTIL
+  // condition reads) is placed after the other arms, so the passes that go on through the
+  // loop do not jump over it (see if_stmt); off, the arms stay in source order.
+  bool cold_arms = true;
   uint32_t image_size_i = 4096, image_size_q = 4096, image_size_m = 16384;
   // The source files of libraries (--library; see library_sources in import/import.hpp),
   // read by build_files before the program's own and compiled with them as library code.

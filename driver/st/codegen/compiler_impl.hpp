@@ -199,6 +199,7 @@ struct Body {
   const Type* this_type = nullptr;  // FB type whose members are reachable (body or method)
   struct Loop {
     Label exit, cont;
+    const Expr* cond = nullptr;  // WHILE: the condition; REPEAT: the UNTIL expression (rule 29)
   };
   std::vector<Loop> loops;
   uint32_t arm = kNoBranch;  // the branch id whose arm is being compiled (coverage nesting)
@@ -340,6 +341,7 @@ class Compiler {
   void stmt(const Stmt& s);
   void assign_stmt(const AssignStmt& s);
   void if_stmt(const IfStmt& s);
+  bool leaves_loop(const StmtList& body) const;
   void case_stmt(const CaseStmt& s);
   void for_stmt(const ForStmt& s);
   void while_stmt(const WhileStmt& s);

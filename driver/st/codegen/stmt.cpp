@@ -2,6 +2,8 @@
 // and the test-file statements; every branch arm gets a coverage id.
 #include <algorithm>
 #include <bit>
+#include <map>
+#include <optional>
 #include <set>
 
 #include <cstring>
@@ -1100,6 +1102,69 @@ Compiler::Held Compiler::compared_elements(const Expr& cond, Label next, const H
   return out;
 }
 
+namespace {
+// The variables an expression of names, literals and operators reads (false: it has
+// anything else, an index, a member, a call).
+bool names_read(const Expr& e, std::vector<std::string>* out) {
+  std::vector<const Expr*> work{&e};
+  while (!work.empty()) {
+    const Expr* x = work.back();
+    work.pop_back();
+    switch (x->kind) {
+      case ExprKind::Name: out->push_back(static_cast<const NameExpr*>(x)->name.text); break;
+      case ExprKind::Literal: case ExprKind::EnumLiteral: break;
+      case ExprKind::Unary: work.push_back(static_cast<const UnaryExpr*>(x)->operand.get()); break;
+      case ExprKind::Binary:
+        work.push_back(static_cast<const BinaryExpr*>(x)->lhs.get());
+        work.push_back(static_cast<const BinaryExpr*>(x)->rhs.get());
+        break;
+      default: return false;
+    }
+  }
+  return true;
+}
+
+bool has_name(const std::vector<std::string>& names, const std::string& n) {
+  return std::any_of(names.begin(), names.end(), [&](const std::string& x) { return iequals(x, n); });
+}
+}  // namespace
+
+// Rule 29: whether an arm of the IF that ends a loop body leaves the loop: a statement of
+// its own list (not nested) is EXIT or RETURN, or assigns to a variable that the innermost
+// WHILE's condition or REPEAT's UNTIL reads a value made of literals and the condition's
+// other variables (`found := TRUE`, `i := 64` in `WHILE i < 64`, `lo := hi + 1` in
+// `WHILE lo <= hi`; not `lo := half + 1`, not `i := i + 1`). Such an arm runs once per
+// entry of the loop; the others run on every pass.
+bool Compiler::leaves_loop(const StmtList& body) const {
+  std::vector<std::string> reads;
+  if (!b_->loops.empty() && b_->loops.back().cond && !names_read(*b_->loops.back().cond, &reads)) {
+    // A condition with an index or a call: only its plain names count.
+    reads.clear();
+    std::vector<const Expr*> work{b_->loops.back().cond};
+    while (!work.empty()) {
+      const Expr* x = work.back();
+      work.pop_back();
+      if (x->kind == ExprKind::Name) reads.push_back(static_cast<const NameExpr*>(x)->name.text);
+      else if (x->kind == ExprKind::Unary) work.push_back(static_cast<const UnaryExpr*>(x)->operand.get());
+      else if (x->kind == ExprKind::Binary) {
+        work.push_back(static_cast<const BinaryExpr*>(x)->lhs.get());
+        work.push_back(static_cast<const BinaryExpr*>(x)->rhs.get());
+      }
+    }
+  }
+  for (const auto& st : body) {
+    if (st->kind == StmtKind::Exit || st->kind == StmtKind::Return) return true;
+    if (st->kind != StmtKind::Assign) continue;
+    const auto& a = static_cast<const AssignStmt&>(*st);
+    if (a.is_ref_assign || a.set_reset || a.chained || a.declares_temp || a.lhs->kind != ExprKind::Name) continue;
+    const std::string& name = static_cast<const NameExpr&>(*a.lhs).name.text;
+    std::vector<std::string> value;
+    if (!has_name(reads, name) || !names_read(*a.rhs, &value) || has_name(value, name)) continue;
+    if (std::all_of(value.begin(), value.end(), [&](const std::string& v) { return has_name(reads, v); })) return true;
+  }
+  return false;
+}
+
 void Compiler::if_stmt(const IfStmt& s) {
   if (select_if(s)) return;
   Label end = new_label();
@@ -1137,10 +1202,93 @@ void Compiler::if_stmt(const IfStmt& s) {
   // with a copy of its bottom) and from the last condition without ELSE.
   const bool tails = loop_tail_ != nullptr;
   std::vector<bool> conds = watch_state(), after = conds;
+  // Rule 29: the arms that leave the loop, placed after the others (each condition in
+  // its place, jumping to its arm when it holds). Not with coverage: the arms' ids would
+  // be numbered in another order than the source's.
+  struct Cold {
+    size_t arm;
+    Label at;
+    std::vector<bool> watch;
+    std::vector<const Expr*> rest;  // an AND's terms after the first, tested at `at`
+    Held held;                      // what the condition loaded (rule 27)
+  };
+  std::vector<Cold> cold;
+  // Placed after the last conditional arm when that one stays in the loop (before the
+  // ELSE, which its condition jumps to, as the arms that leave do not), else after the
+  // ELSE; an ELSE that leaves the loop too then keeps the source's order (it would jump).
+  const bool last_leaves = tails && leaves_loop(s.arms.back().body);
+  const bool place_cold = tails && opt_.cold_arms && !opt_.coverage && !(last_leaves && s.else_body && leaves_loop(*s.else_body));
+  // The arms that leave, each after its own condition's jump; the last one may fall
+  // through to the statement's end when nothing follows it.
+  auto emit_cold = [&](bool last_falls) {
+    for (size_t k = 0; k < cold.size(); ++k) {
+      const auto& arm = s.arms[cold[k].arm];
+      bind(cold[k].at);
+      mark(arm.loc);
+      set_watch_state(cold[k].watch);
+      const uint32_t saved = b_->temp_top;
+      Label fails = new_label();
+      for (const Expr* t : cold[k].rest) {
+        cond_branch(*t, fails, false);  // read only, cannot fail (chain_terms)
+        b_->temp_top = saved;
+      }
+      {
+        ArmScope in(b_, branch(arm.loc, !arm.label.empty() ? arm.label.c_str() : cold[k].arm == 0 ? "IF" : "ELSIF",
+                               s.loc, &decision, arm.body));
+        hold(first_value(arm.body), cold[k].held);  // reached straight from its condition
+        stmts(arm.body);
+        release();
+      }
+      b_->temp_top = saved;
+      if (k + 1 < cold.size() || !cold[k].rest.empty() || !last_falls) arm_end(end);
+      merge_watch_state(&after, watch_state());
+      if (!cold[k].rest.empty()) {
+        // The AND failed after its first term: the ELSE again (it ends the statement).
+        bind(fails);
+        set_watch_state(cold[k].watch);
+        if (s.else_body) {
+          app_->copied_statements = true;
+          stmts(*s.else_body);
+          b_->temp_top = saved;
+        }
+        merge_watch_state(&after, watch_state());
+      }
+    }
+    cold.clear();
+  };
   for (size_t i = 0; i < s.arms.size(); ++i) {
     const auto& arm = s.arms[i];
     uint32_t saved = b_->temp_top;
     mark(arm.loc);
+    if (place_cold && leaves_loop(arm.body)) {
+      set_watch_state(conds);
+      Label at = new_label();
+      // `a AND b`, the last condition, an ELSE of a few short assignments or none: a
+      // jump to `at` when a holds, b tested there; where it fails, a copy of the ELSE
+      // (and the loop's bottom) follows, so that the passes on which a fails, the most
+      // of a search, go straight on.
+      std::vector<const Expr*> terms;
+      const bool split = cold.empty() && i + 1 == s.arms.size() && (!s.else_body || short_rest(*s.else_body, 0)) &&
+                         arm.cond->kind == ExprKind::Binary &&
+                         static_cast<const BinaryExpr&>(*arm.cond).op == BinaryOp::And && chain_terms(*arm.cond, &terms);
+      if (split) app_->condition_chains = true;
+      hold(arm.cond.get(), held);
+      const bool carried = !reuse.empty();
+      Val c = cond_branch(split ? *terms[0] : *arm.cond, at, true);
+      release();
+      if (split) terms.erase(terms.begin());
+      else terms.clear();
+      if (opt_.warnings && c.ok && c.is_const && !(b_->pou && b_->pou->is_stdlib))
+        diags_.warning("ST404", arm.cond->loc, std::string("condition is always ") + (c.c.i ? "TRUE" : "FALSE"));
+      // Rule 27: what the comparison loaded is there both where it jumps (the arm, placed
+      // later) and where it falls through (the next condition).
+      held = !split && c.ok && !c.is_const ? compared_elements(*arm.cond, at, carried ? held : Held{}) : Held{};
+      conds = watch_state();
+      cold.push_back({i, at, conds, std::move(terms), held});
+      b_->temp_top = saved;
+      app_->cold_arms = true;
+      continue;
+    }
     Label next = new_label();
     set_watch_state(conds);
     hold(arm.cond.get(), held);
@@ -1160,8 +1308,10 @@ void Compiler::if_stmt(const IfStmt& s) {
       release();
       b_->temp_top = saved;
     }
-    if (i + 1 < s.arms.size() || s.else_body) arm_end(end);
+    const bool cold_here = !cold.empty() && i + 1 == s.arms.size();  // this arm stays, the last
+    if (i + 1 < s.arms.size() || s.else_body || cold_here) arm_end(end);
     if (!tails || (i + 1 == s.arms.size() && !s.else_body)) merge_watch_state(&after, watch_state());
+    if (cold_here) emit_cold(false);
     bind(next);
   }
   set_watch_state(conds);
@@ -1174,6 +1324,11 @@ void Compiler::if_stmt(const IfStmt& s) {
     b_->temp_top = saved;
   }
   merge_watch_state(&after, watch_state());
+  if (!cold.empty()) {
+    // The passes that stay in the loop end here; the arms that leave it follow.
+    arm_end(end);
+    emit_cold(true);
+  }
   set_watch_state(after);
   bind_forward(end);
 }
@@ -1804,6 +1959,33 @@ void Compiler::merge_watch_state(std::vector<bool>* into, const std::vector<bool
   for (size_t k = 0; k < s.size() && k < into->size(); ++k) (*into)[k] = (*into)[k] || s[k];
 }
 
+// The conditional jump taken exactly when `op` is not (JMPF/JMPT, JEQ/JNE, JTZ/JTNZ,
+// JLT/JGE on integers, JLT/JNLT and JGE/JNGE on REAL and LREAL, where NaN fails both).
+static std::optional<Op> inverse_jump(Op op) {
+  static const std::vector<std::optional<Op>> table = [] {
+    std::map<std::string, Op> by_name;
+    for (uint32_t k = 0; k < static_cast<uint32_t>(Op::Count_); ++k) by_name[op_info(static_cast<Op>(k)).name] = static_cast<Op>(k);
+    std::vector<std::optional<Op>> t(static_cast<size_t>(Op::Count_));
+    auto swap_prefix = [](const std::string& n, const std::string& a, const std::string& b) {
+      return n.starts_with(a) ? b + n.substr(a.size()) : std::string();
+    };
+    for (const auto& [name, o] : by_name) {
+      if (!is_conditional_jump(o)) continue;
+      const bool real = name.ends_with("_F32") || name.ends_with("_F64");
+      std::string inv = name == "JMPF" ? "JMPT" : name == "JMPT" ? "JMPF" : "";
+      for (const auto& [a, b] : std::initializer_list<std::pair<const char*, const char*>>{
+               {"JEQ_", "JNE_"}, {"JNE_", "JEQ_"}, {"JTZ_", "JTNZ_"}, {"JTNZ_", "JTZ_"}, {"JNLT_", "JLT_"}, {"JNGE_", "JGE_"}}) {
+        if (inv.empty()) inv = swap_prefix(name, a, b);
+      }
+      if (inv.empty()) inv = swap_prefix(name, "JLT_", real ? "JNLT_" : "JGE_");
+      if (inv.empty()) inv = swap_prefix(name, "JGE_", real ? "JNGE_" : "JLT_");
+      if (auto it = by_name.find(inv); it != by_name.end()) t[static_cast<size_t>(o)] = it->second;
+    }
+    return t;
+  }();
+  return table[static_cast<size_t>(op)];
+}
+
 void Compiler::jump_back(Label body) {
   const auto& code = b_->code;
   const uint32_t at = b_->label_pos[body.id];
@@ -1813,13 +1995,26 @@ void Compiler::jump_back(Label body) {
     bool plain = at + len <= code.size() && target != b_->target_fix.end();
     for (uint32_t w = at + 2; plain && w < at + len; ++w) plain = kind_at(w) == SK::Var || kind_at(w) == SK::Const;
     if (plain) {
-      std::vector<Arg> args{Arg::target(target->second)};
-      for (uint32_t w = at + 2; w < at + len; ++w) args.push_back(Arg(Slot{code[w], kind_at(w)}));
-      emit_list(static_cast<Op>(code[at]), args);
       const Label rest = new_label();
       b_->label_pos[rest.id] = at + len;
-      emit(Op::JMPB, {Arg::target(rest.id)});
-      return;
+      std::vector<Arg> args{Arg::target(target->second)};
+      for (uint32_t w = at + 2; w < at + len; ++w) args.push_back(Arg(Slot{code[w], kind_at(w)}));
+      if (b_->label_pos[target->second] == UINT32_MAX) {
+        // The first jump leads forward (to an arm placed after the others, rule 29): the
+        // opposite jump back past it, else back to it. Either way one jump back, counted
+        // by the watchdog as the test's was.
+        const auto inverse = inverse_jump(static_cast<Op>(code[at]));
+        if (inverse) {
+          args[0] = Arg::target(rest.id);
+          emit_list(*inverse, args);
+          emit(Op::JMPB, {Arg::target(body.id)});
+          return;
+        }
+      } else {
+        emit_list(static_cast<Op>(code[at]), args);
+        emit(Op::JMPB, {Arg::target(rest.id)});
+        return;
+      }
     }
   }
   emit(Op::JMPB, {Arg::target(body.id)});
@@ -1836,7 +2031,7 @@ void Compiler::while_stmt(const WhileStmt& s) {
   {
     ArmScope in(b_, branch(s.loc, "WHILE", s.loc, &decision, s.body));
     bind(body);
-    b_->loops.push_back({exit, test});
+    b_->loops.push_back({exit, test, s.cond.get()});
     const size_t watch = b_->flag_watches.size();
     if (flag) b_->flag_watches.push_back({*flag, false});
     const std::function<void()> tail = [&] {
@@ -1868,7 +2063,7 @@ void Compiler::while_stmt(const WhileStmt& s) {
 
 void Compiler::repeat_stmt(const RepeatStmt& s) {
   Label body = new_label(), cont = new_label(), exit = new_label();
-  b_->loops.push_back({exit, cont});
+  b_->loops.push_back({exit, cont, s.until.get()});
   uint32_t decision = kNoBranch;
   {
     ArmScope in(b_, branch(s.loc, "REPEAT", s.loc, &decision, s.body));

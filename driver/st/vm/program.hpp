@@ -223,6 +223,10 @@ class Application {
   // Some ELSIF condition reads an element the condition before it loaded
   // (CompileOptions::elsif_reuse): mutation analysis negates conditions one at a time.
   bool elsif_reuse = false;
+  // Some IF that ends a loop body has an arm placed after the others, its condition
+  // jumping there when it holds (CompileOptions::cold_arms): mutation analysis negates
+  // each IF's jump to its next arm.
+  bool cold_arms = false;
   // FB_init/FB_exit (CODESYS): a routine over every program instance and global instance,
   // run by Machine::cold_restart/warm_restart on the frame at lifecycle_addr.
   // The byte at init_flag_addr is what FB_init gets as bInitRetains.
