@@ -714,6 +714,12 @@ bool Machine::run_impl(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* bu
       // Rule 21: one structure element assigned from another (the STXB stores the block the
       // LDXB loaded: its operand g).
       {Op::LDXB, Op::STXB, Op::Count_, 7, 0, LABEL_OFFSET(L_EB_LDXB_STXB)},
+      // Rule 30: a CASE on an INT, UINT, SINT, USINT, BYTE, WORD or enumerated selector
+      // (the jump table's DINT operand a is the conversion's result).
+      {Op::CVT_I16_I32, Op::JTAB, Op::Count_, 1, 0, LABEL_OFFSET(L_CJ_I16)},
+      {Op::CVT_U16_I32, Op::JTAB, Op::Count_, 1, 0, LABEL_OFFSET(L_CJ_U16)},
+      {Op::CVT_I8_I32, Op::JTAB, Op::Count_, 1, 0, LABEL_OFFSET(L_CJ_I8)},
+      {Op::CVT_U8_I32, Op::JTAB, Op::Count_, 1, 0, LABEL_OFFSET(L_CJ_U8)},
 #undef RULE_FF3
 #undef RULE_P
 #undef RULE_F
@@ -1385,6 +1391,24 @@ L_EB_LDXB_STXB: {
   move_element(base + pc[1] + j * pc[5] + pc[6], from, size);
   NEXT(8);
 }
+  // Rule 30: a CASE on a selector narrower than DINT: the conversion's store as it does
+  // it, and the table jump on the value converted, not on the value reloaded from where
+  // the conversion stored it (a store-to-load wait on the way to the next pc).
+#define CASE_ON(N, T)                                                                 \
+  L_CJ_##N: {                                                                         \
+    const int32_t v = static_cast<int32_t>(ld<T>(base + pc[2]));                      \
+    st<int32_t>(base + pc[1], v);                                                     \
+    pc += 3;                                                                          \
+    const int64_t i = int64_t{v} - static_cast<int32_t>(pc[2]);                       \
+    pc = i >= 0 && i < static_cast<int64_t>(pc[3]) ? code + pc[5 + i] : code + pc[4]; \
+    COVER(pc);                                                                        \
+    DISPATCH();                                                                       \
+  }
+  CASE_ON(I16, int16_t)
+  CASE_ON(U16, uint16_t)
+  CASE_ON(I8, int8_t)
+  CASE_ON(U8, uint8_t)
+#undef CASE_ON
   // A reduction loop as a whole (find_reductions, run_reduction).
 L_REDUCE: {
   const auto head = static_cast<uint32_t>(pc - code);
