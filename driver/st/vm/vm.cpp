@@ -361,6 +361,11 @@ const Machine::FusedRule* Machine::first_fit(const std::vector<uint32_t>& code, 
       continue;
     if (f.operand2 != 0 && code[third + f.operand2] != code[next + 1]) continue;
     if (f.yields && heads[code[next]] && first_fit(code, heads, rules, n_rules, next, false)) continue;
+    if (f.dead_head) {
+      const uint32_t len3 = third < n ? instruction_length(code, third) : 0;
+      if (len3 == 0 || std::find(code.begin() + third, code.begin() + third + len3, code[at + 1]) != code.begin() + third + len3)
+        continue;
+    }
     return &f;
   }
   return nullptr;
@@ -545,6 +550,7 @@ std::vector<std::pair<uint32_t, std::string>> Machine::superinstructions() const
   for (auto [pc, f] : fused_) {
     std::string name = std::string(op_info(f->head).name) + "+" + op_info(f->tail).name;
     if (f->third != Op::Count_) name += std::string("+") + op_info(f->third).name;
+    if (f->dead_head) name += " (no temporary)";
     out.emplace_back(pc, std::move(name));
   }
   // A reduction loop is named by the instructions it runs, the loop's included.
@@ -713,6 +719,8 @@ bool Machine::run_impl(uint32_t entry, uint8_t* base, uint32_t mtop, int64_t* bu
 #undef RULE_EU
       // Rule 21: one structure element assigned from another (the STXB stores the block the
       // LDXB loaded: its operand g).
+      // Rule 31: the same, without the copy into the temporary when nothing reads it back.
+      {Op::LDXB, Op::STXB, Op::Count_, 7, 0, LABEL_OFFSET(L_EB_LDXB_STXB_DIRECT), false, true},
       {Op::LDXB, Op::STXB, Op::Count_, 7, 0, LABEL_OFFSET(L_EB_LDXB_STXB)},
       // Rule 30: a CASE on an INT, UINT, SINT, USINT, BYTE, WORD or enumerated selector
       // (the jump table's DINT operand a is the conversion's result).
@@ -1387,6 +1395,21 @@ L_EB_LDXB_STXB: {
   move_element(base + pc[1], from, size);
   pc += 9;
   if (pc[8] != size) goto L_STXB;  // not the block the LDXB loaded: the plain STXB
+  ELEM_INDEX_AS(j, int32_t, 2)
+  move_element(base + pc[1] + j * pc[5] + pc[6], from, size);
+  NEXT(8);
+}
+  // Rule 31: the pair whose temporary nothing reads back (FusedRule::dead_head): one copy,
+  // from element to element (move_element copies whole, so the two may be one element).
+L_EB_LDXB_STXB_DIRECT: {
+  ELEM_INDEX_AS(i, int32_t, 3)
+  const uint8_t* const from = base + pc[2] + i * pc[6] + pc[7];
+  const uint32_t size = pc[8];
+  pc += 9;
+  if (pc[8] != size) {  // not the block the LDXB loaded: both as they are
+    move_element(base + pc[-9 + 1], from, size);
+    goto L_STXB;
+  }
   ELEM_INDEX_AS(j, int32_t, 2)
   move_element(base + pc[1] + j * pc[5] + pc[6], from, size);
   NEXT(8);

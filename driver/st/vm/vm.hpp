@@ -195,6 +195,11 @@ class Machine {
     uint32_t operand, operand2;  // operand2: the same for the third and the second
     int32_t offset;
     bool yields = false;
+    // Only where the instruction after the pair names no word equal to the head's
+    // destination: the head's store into its temporary is then left out (a temporary is
+    // scratch within its statement, see scratch_ranges; the next instruction is where a
+    // chained assignment would read it again).
+    bool dead_head = false;
   };
   void thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules,
                    int32_t reduction);
