@@ -218,14 +218,11 @@ TEST(VmColdArms, ArmsThatLeaveTheLoopPlacedLastComputeTheSame) {
   VmRun on(kCold, cold(true), "cold.st");
   VmRun off(kCold, cold(false), "cold.st");
   ASSERT_TRUE(on.ok() && off.ok());
-  for (int s = 0; s < 300; ++s) {
-    ASSERT_TRUE(on.scan()) << on.m->trap().message;
-    ASSERT_TRUE(off.scan()) << off.m->trap().message;
-    SCOPED_TRACE("scan " + std::to_string(s));
-    for (const char* v : {"P.sum", "P.pos", "P.hit", "P.first", "P.low", "P.cnt", "P.big", "P.small", "P.k", "P.steps",
-                          "P.n", "P.j", "P.where", "P.i", "P.bs", "P.lo", "P.hi"})
-      ASSERT_EQ(on.get(v), off.get(v)) << v;
-  }
+  EXPECT_TRUE(on.b->app->cold_arms);
+  EXPECT_FALSE(off.b->app->cold_arms);
+  vmtest::same_scan_by_scan(kCold, cold(true), cold(false), 300,
+                            {"P.sum", "P.pos", "P.hit", "P.first", "P.low", "P.cnt", "P.big", "P.small", "P.k", "P.steps",
+                             "P.n", "P.j", "P.where", "P.i", "P.bs", "P.lo", "P.hi"});
   same_in_both_tiers("cold.st", kCold, 60, 0, nullptr, cold(true));
 }
 
@@ -284,14 +281,7 @@ PROGRAM P
   END_WHILE;
 END_PROGRAM
 )";
-  for (bool on : {true, false}) {
-    VmRun p(forever, cold(on), "forever.st");
-    ASSERT_TRUE(p.ok());
-    p.m->set_budget(3000);
-    EXPECT_FALSE(p.scan());
-    EXPECT_NE(p.m->trap().message.find("endless loop"), std::string::npos) << p.m->trap().message;
-    EXPECT_EQ(p.get("P.k"), 3001) << (on ? "with the rule" : "without");
-  }
+  vmtest::traps_after_as_many_passes(forever, cold(true), cold(false), 3000, "P.k", 3001);
   // The search runs past the array: the element's index check traps at the IF's line,
   // with the same passes done.
   const char* past = R"(

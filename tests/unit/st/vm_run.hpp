@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <initializer_list>
 #include <memory>
 #include <string>
 
@@ -52,5 +53,35 @@ struct VmRun {
     return n;
   }
 };
+
+// src compiled with and without a rule (`with`, `without`) runs `scans` scans with the
+// same integer values of `vars` after each.
+inline void same_scan_by_scan(const std::string& src, const CompileOptions& with, const CompileOptions& without,
+                              int scans, std::initializer_list<const char*> vars) {
+  VmRun on(src, with, "rule.st");
+  VmRun off(src, without, "rule.st");
+  ASSERT_TRUE(on.ok() && off.ok());
+  for (int s = 0; s < scans; ++s) {
+    ASSERT_TRUE(on.scan()) << on.m->trap().message;
+    ASSERT_TRUE(off.scan()) << off.m->trap().message;
+    SCOPED_TRACE("scan " + std::to_string(s));
+    for (const char* v : vars) ASSERT_EQ(on.get(v), off.get(v)) << v;
+  }
+}
+
+// A loop that never ends, compiled with and without a rule (`with`, `without`): both stop
+// on the watchdog after `budget` passes, leaving `counter` (counted once a pass) at `want`.
+inline void traps_after_as_many_passes(const std::string& src, const CompileOptions& with,
+                                       const CompileOptions& without, int64_t budget, const std::string& counter,
+                                       int64_t want) {
+  for (const CompileOptions* o : {&with, &without}) {
+    VmRun p(src, *o, "forever.st");
+    ASSERT_TRUE(p.ok());
+    p.m->set_budget(budget);
+    EXPECT_FALSE(p.scan());
+    EXPECT_NE(p.m->trap().message.find("endless loop"), std::string::npos) << p.m->trap().message;
+    EXPECT_EQ(p.get(counter), want) << (o == &with ? "with the rule" : "without");
+  }
+}
 
 }  // namespace plcfi::st::vmtest
