@@ -218,5 +218,58 @@ TEST(VmFlagLoops, DeepNestsRunOrEndInTheNestingError) {
   EXPECT_NE(b->diags.render_all().find("ST117"), std::string::npos) << b->diags.render_all();
 }
 
+
+// A flag loop that ends: the watchdog's count of its passes is the plain loop's, to the
+// pass. The shortest budget that lets a scan finish is the same with and without the
+// rule, and one less traps. (The THEN arm's jump back copies `IF k < n`, whose jump leads
+// forward to the ELSE: a copy of it taken there once skipped the count of a pass.)
+TEST(VmFlagLoops, AFiniteLoopNeedsTheSameBudgetToTheLastPass) {
+  const char* src = R"(
+PROGRAM P
+  VAR go : BOOL; k : DINT; n : DINT := 37; m : DINT; END_VAR
+  go := TRUE;
+  k := 0;
+  WHILE go DO
+    IF k < n THEN
+      k := k + 1;
+    ELSE
+      go := FALSE;
+    END_IF;
+  END_WHILE;
+  go := TRUE;
+  WHILE go DO
+    IF m >= 5 THEN
+      go := FALSE;
+    ELSIF k > 0 THEN
+      k := k - 2;
+    ELSE
+      m := m + 1;
+    END_IF;
+  END_WHILE;
+  m := 0;
+END_PROGRAM
+)";
+  auto least = [&](const CompileOptions& o) {
+    for (int64_t b = 1; b < 1000; ++b) {
+      VmRun p(src, o, "ends.st");
+      if (!p.ok()) return int64_t{-1};
+      p.m->set_budget(b);
+      if (p.scan()) return b;
+    }
+    return int64_t{-1};
+  };
+  auto opts = [](bool flag_loops, bool cold_arms) {
+    CompileOptions o = flags(flag_loops);
+    o.coverage = false;  // as `plcfi run` compiles (rule 29 is off with coverage)
+    o.cold_arms = cold_arms;
+    return o;
+  };
+  const int64_t plain = least(opts(false, false));
+  ASSERT_GT(plain, 40);
+  EXPECT_EQ(least(opts(true, false)), plain);
+  EXPECT_EQ(least(opts(true, true)), plain);
+  EXPECT_EQ(least(flags(true)), least(flags(false)));
+}
+
 }  // namespace
 }  // namespace plcfi::st
