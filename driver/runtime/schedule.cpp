@@ -55,6 +55,7 @@ bool Schedule::single_program(const st::Application& app, const std::string& pro
 void Schedule::finish(const st::Application& app) {
   tick_ns_ = 0;
   for (const auto& t : tasks_) tick_ns_ = std::gcd(tick_ns_, t.interval_ns);
+  for (auto& t : tasks_) t.ticks = tick_ns_ > 0 ? static_cast<uint64_t>(t.interval_ns / tick_ns_) : 1;
   std::stable_sort(tasks_.begin(), tasks_.end(), [](const auto& a, const auto& b) { return a.priority < b.priority; });
   // TwinCAT's _TaskInfo (Tc2_System), where the program names it.
   task_info_.assign(tasks_.size(), std::nullopt);

@@ -20,6 +20,7 @@ struct ScheduledTask {
   int64_t priority = 0;
   std::vector<size_t> programs;  // indices into Application::programs
   uint8_t index = 1;  // 1-based, in the configuration's order (GETCURTASKINDEX)
+  uint64_t ticks = 1;  // interval_ns in base ticks (set by the schedule)
 };
 
 class Schedule {
@@ -34,8 +35,10 @@ class Schedule {
   // Tasks due at base tick n (n = 0 is the first scan), in priority order.
   template <class F>
   void for_each_due(uint64_t n, F&& f) const {
+    // (Every scan of a run asks: the period in ticks is worked out once, and a task on
+    // the base tick needs no division.)
     for (const auto& t : tasks_)
-      if (n % static_cast<uint64_t>(t.interval_ns / tick_ns_) == 0) f(t);
+      if (t.ticks == 1 || n % t.ticks == 0) f(t);
   }
   // Calls the programs of the tasks due at base tick n on m, in order, until one traps:
   // then false, with *trap describing it ("... (program Main, cycle 12)").

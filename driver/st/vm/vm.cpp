@@ -134,9 +134,15 @@ bool Machine::restart(bool warm) {
   return ok;
 }
 
-void Machine::clear_taken() { std::fill(taken_.begin(), taken_.end(), 0); }
+// Code threaded as it is now and without a COV instruction marks no branch: nothing to
+// clear or merge (every scan of a run without coverage asks).
+void Machine::clear_taken() {
+  if (exec_.size() == app_->code.size() && !code_has_cov_) return;
+  std::fill(taken_.begin(), taken_.end(), 0);
+}
 
 void Machine::merge_coverage() {
+  if (exec_.size() == app_->code.size() && !code_has_cov_) return;
   for (size_t i = 0; i < taken_.size(); ++i) covered_[i] |= taken_[i];
   if (!count_hits_) return;
   for (size_t w = 0; w < taken_.size(); ++w)
