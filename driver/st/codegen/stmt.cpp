@@ -1103,9 +1103,11 @@ Compiler::Held Compiler::compared_elements(const Expr& cond, Label next, const H
 }
 
 namespace {
-// The variables an expression of names, literals and operators reads (false: it has
-// anything else, an index, a member, a call).
+// The variables named in an expression, through its operators; false when it holds
+// anything but names, literals and operators (an index, a member, a call), whose own
+// names are not collected.
 bool names_read(const Expr& e, std::vector<std::string>* out) {
+  bool plain = true;
   std::vector<const Expr*> work{&e};
   while (!work.empty()) {
     const Expr* x = work.back();
@@ -1118,10 +1120,10 @@ bool names_read(const Expr& e, std::vector<std::string>* out) {
         work.push_back(static_cast<const BinaryExpr*>(x)->lhs.get());
         work.push_back(static_cast<const BinaryExpr*>(x)->rhs.get());
         break;
-      default: return false;
+      default: plain = false; break;
     }
   }
-  return true;
+  return plain;
 }
 
 bool has_name(const std::vector<std::string>& names, const std::string& n) {
@@ -1136,22 +1138,8 @@ bool has_name(const std::vector<std::string>& names, const std::string& n) {
 // `WHILE lo <= hi`; not `lo := half + 1`, not `i := i + 1`). Such an arm runs once per
 // entry of the loop; the others run on every pass.
 bool Compiler::leaves_loop(const StmtList& body) const {
-  std::vector<std::string> reads;
-  if (!b_->loops.empty() && b_->loops.back().cond && !names_read(*b_->loops.back().cond, &reads)) {
-    // A condition with an index or a call: only its plain names count.
-    reads.clear();
-    std::vector<const Expr*> work{b_->loops.back().cond};
-    while (!work.empty()) {
-      const Expr* x = work.back();
-      work.pop_back();
-      if (x->kind == ExprKind::Name) reads.push_back(static_cast<const NameExpr*>(x)->name.text);
-      else if (x->kind == ExprKind::Unary) work.push_back(static_cast<const UnaryExpr*>(x)->operand.get());
-      else if (x->kind == ExprKind::Binary) {
-        work.push_back(static_cast<const BinaryExpr*>(x)->lhs.get());
-        work.push_back(static_cast<const BinaryExpr*>(x)->rhs.get());
-      }
-    }
-  }
+  std::vector<std::string> reads;  // the condition's plain names (not inside an index or a call)
+  if (!b_->loops.empty() && b_->loops.back().cond) names_read(*b_->loops.back().cond, &reads);
   for (const auto& st : body) {
     if (st->kind == StmtKind::Exit || st->kind == StmtKind::Return) return true;
     if (st->kind != StmtKind::Assign) continue;

@@ -136,13 +136,15 @@ bool Machine::restart(bool warm) {
 
 // Code threaded as it is now and without a COV instruction marks no branch: nothing to
 // clear or merge (every scan of a run without coverage asks).
+bool Machine::marks_no_branch() const { return exec_.size() == app_->code.size() && !code_has_cov_; }
+
 void Machine::clear_taken() {
-  if (exec_.size() == app_->code.size() && !code_has_cov_) return;
+  if (marks_no_branch()) return;
   std::fill(taken_.begin(), taken_.end(), 0);
 }
 
 void Machine::merge_coverage() {
-  if (exec_.size() == app_->code.size() && !code_has_cov_) return;
+  if (marks_no_branch()) return;
   for (size_t i = 0; i < taken_.size(); ++i) covered_[i] |= taken_[i];
   if (!count_hits_) return;
   for (size_t w = 0; w < taken_.size(); ++w)
@@ -1394,32 +1396,22 @@ L_JNGE_F64: if (!(R(double, 2) >= R(double, 3))) TAKE(1); FALL(3);
   // index check, from the source element itself. The temporary holds the same bytes, but
   // reading back a block just stored in overlapping pieces (12 bytes as two 8-byte moves)
   // stalls the load until the stores are done, in every pass of an insertion sort.
-L_EB_LDXB_STXB: {
-  ELEM_INDEX_AS(i, int32_t, 3)
-  const uint8_t* const from = base + pc[2] + i * pc[6] + pc[7];
-  const uint32_t size = pc[8];
-  move_element(base + pc[1], from, size);
-  pc += 9;
-  if (pc[8] != size) goto L_STXB;  // not the block the LDXB loaded: the plain STXB
-  ELEM_INDEX_AS(j, int32_t, 2)
-  move_element(base + pc[1] + j * pc[5] + pc[6], from, size);
+#define ELEMENT_COPY(TEMPORARY)                                                          \
+  ELEM_INDEX_AS(i, int32_t, 3)                                                           \
+  const uint8_t* const from = base + pc[2] + i * pc[6] + pc[7];                          \
+  const uint32_t size = pc[8];                                                           \
+  if ((TEMPORARY) || pc[9 + 8] != size) move_element(base + pc[1], from, size);         \
+  pc += 9;                                                                               \
+  if (pc[8] != size) goto L_STXB; /* not the block the LDXB loaded: the plain STXB */   \
+  ELEM_INDEX_AS(j, int32_t, 2)                                                           \
+  move_element(base + pc[1] + j * pc[5] + pc[6], from, size);                            \
   NEXT(8);
-}
+L_EB_LDXB_STXB: { ELEMENT_COPY(true) }
   // Rule 31: the pair whose temporary nothing reads back (FusedRule::dead_head): one copy,
   // from element to element (move_element copies whole, so the two may be one element).
-L_EB_LDXB_STXB_DIRECT: {
-  ELEM_INDEX_AS(i, int32_t, 3)
-  const uint8_t* const from = base + pc[2] + i * pc[6] + pc[7];
-  const uint32_t size = pc[8];
-  pc += 9;
-  if (pc[8] != size) {  // not the block the LDXB loaded: both as they are
-    move_element(base + pc[-9 + 1], from, size);
-    goto L_STXB;
-  }
-  ELEM_INDEX_AS(j, int32_t, 2)
-  move_element(base + pc[1] + j * pc[5] + pc[6], from, size);
-  NEXT(8);
-}
+  // The plain STXB, where it runs instead, reads the temporary: it is written then.
+L_EB_LDXB_STXB_DIRECT: { ELEMENT_COPY(false) }
+#undef ELEMENT_COPY
   // Rule 30: a CASE on a selector narrower than DINT: the conversion's store as it does
   // it, and the table jump on the value converted, not on the value reloaded from where
   // the conversion stored it (a store-to-load wait on the way to the next pc).

@@ -197,8 +197,8 @@ class Machine {
     bool yields = false;
     // Only where the instruction after the pair names no word equal to the head's
     // destination: the head's store into its temporary is then left out (a temporary is
-    // scratch within its statement, see scratch_ranges; the next instruction is where a
-    // chained assignment would read it again).
+    // scratch within its statement, see scratch_ranges; the pair ends an assignment, so
+    // that test is a conservative one for any later reader).
     bool dead_head = false;
   };
   void thread_code(const int32_t* offsets, int32_t invalid, const FusedRule* rules, size_t n_rules,
@@ -245,6 +245,7 @@ class Machine {
   // the first call: the application's code must not change while the machine is used
   // (mutation analysis patches it before it makes the machines that run the mutant).
   std::vector<uint32_t> exec_;
+  bool marks_no_branch() const;
   bool code_has_cov_ = false;  // the application's code holds a COV (set when exec_ is built)
   std::vector<std::pair<uint32_t, const FusedRule*>> fused_;  // the heads rewritten in exec_
   std::vector<Reduction> reductions_;  // by head, ascending; their heads rewritten in exec_
