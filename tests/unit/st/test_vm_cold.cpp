@@ -309,5 +309,38 @@ END_PROGRAM
   EXPECT_EQ(where[0], where[1]);
 }
 
+
+// Searches nested `depth` deep, each loop ended by an IF whose found arm sets its counter
+// past the bound; the innermost condition an AND of `terms` comparisons of one element.
+std::string nested_searches(int depth, int terms) {
+  std::string src = "PROGRAM P\nVAR\n  a : ARRAY [0..3] OF DINT := [1, 2, 3, 4];\n  k : DINT := 0;\n";
+  for (int i = 0; i < depth; ++i) src += "  i" + std::to_string(i) + " : DINT;\n";
+  src += "END_VAR\n";
+  for (int i = 0; i < depth; ++i) src += "i" + std::to_string(i) + " := 0;\nWHILE i" + std::to_string(i) + " < 2 DO\n";
+  std::string cond = "a[k MOD 4] > 0";
+  for (int t = 1; t < terms; ++t) cond += " AND a[k MOD 4] <> " + std::to_string(100 + t);
+  src += "k := k + 1;\nIF " + cond + " AND k > 1000000 THEN i" + std::to_string(depth - 1) + " := 2; ELSE i" +
+         std::to_string(depth - 1) + " := i" + std::to_string(depth - 1) + " + 1; END_IF;\nEND_WHILE;\n";
+  for (int i = depth - 2; i >= 0; --i)
+    src += "IF k < 0 THEN i" + std::to_string(i) + " := 2; ELSE i" + std::to_string(i) + " := i" + std::to_string(i) +
+           " + 1; END_IF;\nEND_WHILE;\n";
+  return src + "END_PROGRAM\n";
+}
+
+TEST(VmColdArms, DeepNestsAndLongConditionsRunOrEndInTheNestingError) {
+  // 2 passes per level: k counts the innermost body's passes, 2^12.
+  const std::string deep = nested_searches(12, 200);
+  vmtest::same_scan_by_scan(deep, cold(true), cold(false), 2, {"P.k"});
+  VmRun p(deep, cold(true), "deep.st");
+  ASSERT_TRUE(p.ok());
+  ASSERT_TRUE(p.scan()) << p.m->trap().message;
+  EXPECT_EQ(p.get("P.k"), 4096);
+  same_in_both_tiers("deep.st", deep, 1, 0, nullptr, cold(true));
+  // A nest deeper than the parser takes: its error, not a crash.
+  auto b = build_sources({{"deeper.st", nested_searches(200, 2)}}, cold(true));
+  EXPECT_FALSE(b->ok());
+  EXPECT_NE(b->diags.render_all().find("ST117"), std::string::npos) << b->diags.render_all();
+}
+
 }  // namespace
 }  // namespace plcfi::st
